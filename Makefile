@@ -1,0 +1,35 @@
+# wheelins: the README's two quick-start commands are `make demo` and `make test`.
+BUILD ?= build
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+WHEELINS_WERROR ?= OFF
+DEMO_DIR ?= out/demo
+WHEELINS := $(BUILD)/wheelins
+
+.PHONY: all setup configure build demo test bench clean format
+
+all: build
+
+setup:
+	@scripts/setup.sh
+
+configure: setup
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DWHEELINS_WERROR=$(WHEELINS_WERROR) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD) -j$(JOBS)
+
+# Simulate the built-in default scenario, then run the main job on it.
+demo: build
+	@scripts/demo.sh $(WHEELINS) $(DEMO_DIR)
+
+test: build
+	@ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
+
+bench: build
+	@$(BUILD)/wheelins_bench
+
+format:
+	@clang-format -i $$(git ls-files '*.cpp' '*.hpp')
+
+clean:
+	@rm -rf $(BUILD)

@@ -1,0 +1,103 @@
+#include "wheelins/io/binary.hpp"
+
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <system_error>
+
+#include "wheelins/nav/types.hpp"
+
+static_assert(std::endian::native == std::endian::little,
+              "wheelins reads little-endian float64 files natively; add byte swapping here");
+
+namespace wheelins {
+namespace {
+constexpr std::size_t kBlockBytes = 1 << 20;  // 1 MiB of rows per read/write
+
+std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+}  // namespace
+
+BinaryRowReader::BinaryRowReader(const std::filesystem::path& file, int ncols)
+    : file_(file), ncols_(ncols) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(file, ec);
+  if (ec || !std::filesystem::exists(st))
+    throw InputError(quote(file) + ": file not found");
+  if (std::filesystem::is_directory(st))
+    throw InputError(quote(file) + ": is a directory, expected a binary data file");
+  const auto bytes = std::filesystem::file_size(file, ec);
+  if (ec) throw InputError(quote(file) + ": cannot read size: " + ec.message());
+  const std::uint64_t row_bytes = sizeof(double) * static_cast<std::uint64_t>(ncols);
+  if (bytes % row_bytes != 0)
+    throw InputError(quote(file) + ": size " + std::to_string(bytes) +
+                     " bytes is not a multiple of the row size (" + std::to_string(ncols) +
+                     " float64 = " + std::to_string(row_bytes) + " bytes): truncated, or not a " +
+                     std::to_string(ncols) + "-column file; the last complete record is " +
+                     std::to_string(bytes / row_bytes));
+  rows_ = bytes / row_bytes;
+  fp_ = std::fopen(file.c_str(), "rb");
+  if (!fp_) throw InputError(quote(file) + ": cannot open: " + std::strerror(errno));
+  block_.resize(std::max<std::size_t>(1, kBlockBytes / row_bytes) * ncols);
+}
+
+BinaryRowReader::~BinaryRowReader() {
+  if (fp_) std::fclose(fp_);
+}
+
+const double* BinaryRowReader::next() {
+  if (block_pos_ == block_rows_) {
+    if (next_row_ >= rows_) return nullptr;
+    const std::size_t want = block_.size() / ncols_;
+    block_rows_ = std::fread(block_.data(), sizeof(double) * ncols_, want, fp_);
+    block_pos_ = 0;
+    if (block_rows_ == 0)
+      throw InputError(quote(file_) + ": read failed at record " + std::to_string(next_row_) +
+                       " (file changed while reading?)");
+  }
+  const double* row = block_.data() + block_pos_ * ncols_;
+  ++block_pos_;
+  ++next_row_;
+  return row;
+}
+
+BinaryRowWriter::BinaryRowWriter(const std::filesystem::path& file, int ncols)
+    : file_(file), tmp_(file.string() + ".partial"), ncols_(ncols) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  fp_ = std::fopen(tmp_.c_str(), "wb");
+  if (!fp_) throw InputError(quote(tmp_) + ": cannot create: " + std::strerror(errno));
+  block_.reserve(kBlockBytes / sizeof(double));
+}
+
+BinaryRowWriter::~BinaryRowWriter() {
+  if (fp_) std::fclose(fp_);
+  if (!committed_) {
+    std::error_code ec;
+    std::filesystem::remove(tmp_, ec);
+  }
+}
+
+void BinaryRowWriter::write(const double* row) {
+  block_.insert(block_.end(), row, row + ncols_);
+  ++rows_;
+  if (block_.size() + ncols_ > block_.capacity()) flush();
+}
+
+void BinaryRowWriter::flush() {
+  if (block_.empty()) return;
+  if (std::fwrite(block_.data(), sizeof(double), block_.size(), fp_) != block_.size())
+    throw InputError(quote(tmp_) + ": write failed: " + std::strerror(errno));
+  block_.clear();
+}
+
+void BinaryRowWriter::commit() {
+  flush();
+  if (std::fclose(fp_) != 0) {
+    fp_ = nullptr;
+    throw InputError(quote(tmp_) + ": close failed: " + std::strerror(errno));
+  }
+  fp_ = nullptr;
+  std::filesystem::rename(tmp_, file_);
+  committed_ = true;
+}
+
+}  // namespace wheelins
