@@ -27,7 +27,7 @@ TEST(Rotation, EulerIsZyx) {
 }
 
 TEST(Rotation, RotvecExpLog) {
-  for (const Vec3 rv : {Vec3(0.1, -0.2, 0.3), Vec3(1e-10, 0, 0), Vec3(0, 3.0, 0.1)}) {
+  for (const Vec3& rv : {Vec3(0.1, -0.2, 0.3), Vec3(1e-10, 0, 0), Vec3(0, 3.0, 0.1)}) {
     const Vec3 back = rotvec_from_quat(quat_from_rotvec(rv));
     EXPECT_NEAR((back - rv).norm(), 0.0, 1e-12);
     // exp([rv]x) via series vs closed form
@@ -47,7 +47,7 @@ TEST(Rotation, Skew) {
 
 TEST(Rotation, JacobiansMatchIntegral) {
   // integral_0^1 exp(s [phi]) ds == J_l(phi); J_r^{-1} is the inverse of J_r.
-  for (const Vec3 phi : {Vec3(0.075, 0.001, -0.002), Vec3(1.0, -0.5, 0.3), Vec3(1e-7, 0, 0)}) {
+  for (const Vec3& phi : {Vec3(0.075, 0.001, -0.002), Vec3(1.0, -0.5, 0.3), Vec3(1e-7, 0, 0)}) {
     Mat3 integral = Mat3::Zero();
     const int n = 2000;
     for (int i = 0; i < n; ++i) integral += dcm_from_rotvec(phi * ((i + 0.5) / n)) / n;
