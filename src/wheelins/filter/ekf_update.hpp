@@ -1,0 +1,62 @@
+// The EKF measurement update shared by every measurement model, with a
+// PX4-EKF2-style report of what each fusion did.
+//
+// Convention: the innovation is dz = z_hat - z_meas = H dx + e (dx = estimate - truth),
+// the error estimate is dx = K dz, and the caller feeds dx back into its state.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <array>
+
+#include "wheelins/filter/error_state.hpp"
+
+namespace wheelins {
+
+/// Chi-square quantile at 99.9 % for 1..6 degrees of freedom (innovation gating).
+constexpr std::array<double, 7> kChi2_999 = {0.0, 10.828, 13.816, 16.266, 18.467, 20.515, 22.458};
+
+/// What one fusion did: innovation, its predicted variance, and the test ratio
+/// NIS / chi2_999(dim) (> 1 means the innovation is inconsistent at 99.9 %).
+struct UpdateReport {
+  int dim = 0;
+  std::array<double, 6> innovation{};
+  std::array<double, 6> innovation_var{};
+  double nis = 0.0;
+  double test_ratio = 0.0;
+  bool accepted = false;
+};
+
+/// Fuses one measurement of dimension M into (P, dx). With gate > 0, rejects it
+/// (P and dx untouched) when test_ratio > gate. Joseph form keeps P positive.
+template <int M>
+UpdateReport ekf_update(Mat21& P, Vec21& dx, const Eigen::Matrix<double, M, kStateDim>& H,
+                        const Eigen::Matrix<double, M, 1>& dz,
+                        const Eigen::Matrix<double, M, M>& R, double gate = 0.0) {
+  static_assert(M >= 1 && M <= 6);
+  using MatM = Eigen::Matrix<double, M, M>;
+  using MatNM = Eigen::Matrix<double, kStateDim, M>;
+  const MatNM PHt = P * H.transpose();
+  const MatM S = H * PHt + R;
+  const Eigen::LLT<MatM> llt(S);
+  UpdateReport rep;
+  rep.dim = M;
+  for (int i = 0; i < M; ++i) {
+    rep.innovation[i] = dz(i);
+    rep.innovation_var[i] = S(i, i);
+  }
+  if (llt.info() != Eigen::Success) return rep;  // S not positive: skip, report not accepted
+  rep.nis = dz.dot(llt.solve(dz));
+  rep.test_ratio = rep.nis / kChi2_999[M];
+  if (gate > 0.0 && rep.test_ratio > gate) return rep;
+
+  const MatNM K = llt.solve(PHt.transpose()).transpose();
+  dx += K * (dz - H * dx);
+  Mat21 IKH = -K * H;
+  IKH.diagonal().array() += 1.0;
+  P = IKH * P * IKH.transpose() + K * R * K.transpose();
+  P = 0.5 * (P + P.transpose()).eval();
+  rep.accepted = true;
+  return rep;
+}
+
+}  // namespace wheelins

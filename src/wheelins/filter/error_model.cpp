@@ -1,0 +1,64 @@
+#include "wheelins/filter/error_model.hpp"
+
+namespace wheelins {
+
+ProcessNoise ProcessNoise::from(const ImuNoise& n) {
+  ProcessNoise q;
+  q.gyro_arw = n.gyro_arw;
+  q.acc_vrw = n.acc_vrw;
+  q.gyro_bias_std = n.gyro_bias_std;
+  q.acc_bias_std = n.acc_bias_std;
+  q.gyro_sf_std = n.gyro_sf_std;
+  q.acc_sf_std = n.acc_sf_std;
+  q.gyro_bias_tau = n.gyro_bias_tau;
+  q.acc_bias_tau = n.acc_bias_tau;
+  q.gyro_sf_tau = n.gyro_sf_tau;
+  q.acc_sf_tau = n.acc_sf_tau;
+  return q;
+}
+
+Mat21 error_dynamics(const Mat3& C, const Vec3& omega_b, const Vec3& f_b, const Vec3& omega_ie,
+                     const ProcessNoise& q) {
+  Mat21 F = Mat21::Zero();
+  const Mat3 I = Mat3::Identity();
+  F.block<3, 3>(P, V) = I;
+  F.block<3, 3>(V, V) = -2.0 * skew(omega_ie);
+  F.block<3, 3>(V, PHI) = skew(C * f_b);
+  F.block<3, 3>(V, BA) = C;
+  F.block<3, 3>(V, SA) = C * f_b.asDiagonal();
+  F.block<3, 3>(PHI, PHI) = -skew(omega_ie);
+  F.block<3, 3>(PHI, BG) = -C;
+  F.block<3, 3>(PHI, SG) = -C * omega_b.asDiagonal();
+  F.block<3, 3>(BG, BG) = -I / q.gyro_bias_tau;
+  F.block<3, 3>(BA, BA) = -I / q.acc_bias_tau;
+  F.block<3, 3>(SG, SG) = -I / q.gyro_sf_tau;
+  F.block<3, 3>(SA, SA) = -I / q.acc_sf_tau;
+  return F;
+}
+
+void propagate_covariance(Mat21& P, const Mat21& F, const ProcessNoise& q, double dt) {
+  Vec21 qc = Vec21::Zero();
+  qc.segment<3>(V).setConstant(q.acc_vrw * q.acc_vrw);
+  qc.segment<3>(PHI).setConstant(q.gyro_arw * q.gyro_arw);
+  // First-order Gauss-Markov driving noise: 2 sigma^2 / tau.
+  qc.segment<3>(BG).setConstant(2.0 * q.gyro_bias_std * q.gyro_bias_std / q.gyro_bias_tau);
+  qc.segment<3>(BA).setConstant(2.0 * q.acc_bias_std * q.acc_bias_std / q.acc_bias_tau);
+  qc.segment<3>(SG).setConstant(2.0 * q.gyro_sf_std * q.gyro_sf_std / q.gyro_sf_tau);
+  qc.segment<3>(SA).setConstant(2.0 * q.acc_sf_std * q.acc_sf_std / q.acc_sf_tau);
+
+  Mat21 Phi = F * dt;
+  Phi.diagonal().array() += 1.0;
+  const Mat21 PhiQ = Phi * qc.asDiagonal();
+  P = Phi * P * Phi.transpose();
+  P.noalias() += 0.5 * dt * (PhiQ * Phi.transpose());
+  P.diagonal() += 0.5 * dt * qc;
+  condition_covariance(P);
+}
+
+void condition_covariance(Mat21& P) {
+  P = 0.5 * (P + P.transpose()).eval();
+  for (int i = 0; i < kStateDim; ++i)
+    if (P(i, i) < 0.0) P(i, i) = 0.0;
+}
+
+}  // namespace wheelins

@@ -1,0 +1,52 @@
+#include "wheelins/filter/wheel_velocity.hpp"
+
+#include <cmath>
+
+namespace wheelins {
+
+double wheel_vehicle_heading(const Mat3& C, int axle_sign) {
+  return wrap_pi(yaw_from_dcm(C) - axle_sign * 0.5 * kPi);
+}
+
+WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
+  const Mat3& C = in.C_BtoW;
+  const Vec3& l = in.lever_arm_inB;
+  const double psi = wheel_vehicle_heading(C, in.axle_sign);
+
+  // C_v^w = Rz(psi) Ry(theta) Rx(phi); its transpose maps w-frame vectors into the v-frame.
+  const Mat3 Rz = rot_z(psi), Ryx = rot_y(in.vehicle_pitch) * rot_x(in.vehicle_roll);
+  const Mat3 C_WtoV = (Rz * Ryx).transpose();
+
+  const Vec3 omega_nb = in.omega_ib_b - C.transpose() * in.omega_ie_inW;
+  const Vec3 rot_vel_inW = C * omega_nb.cross(l);  // C_b^w (omega_nb x l)
+  const Vec3 u = in.v_IinW + rot_vel_inW;          // wheel-centre velocity, w-frame
+
+  WheelVelocityModel m;
+  m.z_hat = C_WtoV * u;
+  m.z_meas = Vec3(-in.axle_sign * in.radius * in.mean_omega_x, 0.0, 0.0);
+
+  // d z_hat / d dv  (eq. 5, second term)
+  m.H.block<3, 3>(0, V) = C_WtoV;
+
+  // d z_hat / d phi: through C_b^w in the lever-arm term and the earth-rate term,
+  // and through the heading psi_v = yaw(C_b^w) - axle_sign*pi/2 (the A and B blocks of App. B).
+  const Vec3 c1 = C.col(0);
+  const double h2 = c1.x() * c1.x() + c1.y() * c1.y();
+  const Eigen::RowVector3d dpsi_dc1(-c1.y() / h2, c1.x() / h2, 0.0);
+  const Eigen::RowVector3d dpsi_dphi = dpsi_dc1 * skew(c1);
+  const Vec3 dz_dpsi = -(Ryx.transpose() * skew(Vec3::UnitZ()) * Rz.transpose()) * u;
+  m.H.block<3, 3>(0, PHI) = C_WtoV * (skew(rot_vel_inW) - C * skew(l) * C.transpose() *
+                                                               skew(in.omega_ie_inW)) +
+                            dz_dpsi * dpsi_dphi;
+
+  // d z_hat / d b_g and d s_g (the D block): omega_hat = omega + b_g + diag(omega) s_g.
+  const Mat3 Hbg = -C_WtoV * C * skew(l);
+  m.H.block<3, 3>(0, BG) = Hbg;
+  m.H.block<3, 3>(0, SG) = Hbg * in.omega_ib_b.asDiagonal();
+  // The measured speed comes from the same compensated gyro: dz = z_hat - z_meas.
+  m.H(0, BG) += in.axle_sign * in.radius;
+  m.H(0, SG) += in.axle_sign * in.radius * in.mean_omega_x;
+  return m;
+}
+
+}  // namespace wheelins

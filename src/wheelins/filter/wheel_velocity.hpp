@@ -1,0 +1,43 @@
+// Wheel velocity + non-holonomic constraint for a Wheel-IMU (paper Section V-A,
+// eq. 4-5 and H_v of Appendix B).
+//
+// Predicted: the wheel-centre velocity in the v-frame,
+//   z_hat = C_w^v(psi_v) [ v^w + C_b^w (omega_nb^b x l^b) ],
+//   psi_v = yaw(C_b^w) - axle_sign * pi/2, vehicle roll/pitch given (0 on a plane,
+//   or shared by a Body-INS).
+// Measured: z = [ -axle_sign * r * mean(omega_x), 0, 0 ] (forward speed + NHC).
+// Innovation dz = z_hat - z = H dx. H is exact to first order for the error
+// conventions of error_state.hpp: it keeps the full heading sensitivity of the
+// Wheel-IMU attitude (not only phi_z) and, because the speed comes from the
+// compensated gyro, the b_g,x / s_g,x terms of the measured speed.
+#pragma once
+
+#include "wheelins/filter/error_state.hpp"
+
+namespace wheelins {
+
+struct WheelVelocityInput {
+  Mat3 C_BtoW = Mat3::Identity();
+  Vec3 v_IinW = Vec3::Zero();
+  Vec3 omega_ib_b = Vec3::Zero();    ///< compensated angular rate at this epoch [rad/s]
+  Vec3 omega_ie_inW = Vec3::Zero();  ///< earth rate in the w-frame (zero if ignored)
+  Vec3 lever_arm_inB = Vec3::Zero(); ///< IMU centre -> wheel centre [m]
+  double vehicle_roll = 0.0, vehicle_pitch = 0.0;  ///< [rad]
+  int axle_sign = 1;
+  double radius = 0.0;               ///< wheel radius [m]
+  double mean_omega_x = 0.0;         ///< compensated gyro x averaged over the speed window [rad/s]
+};
+
+struct WheelVelocityModel {
+  Vec3 z_hat = Vec3::Zero();   ///< predicted wheel-centre velocity in the v-frame
+  Vec3 z_meas = Vec3::Zero();  ///< measured [speed, 0, 0]
+  Eigen::Matrix<double, 3, kStateDim> H = Eigen::Matrix<double, 3, kStateDim>::Zero();
+  Vec3 innovation() const { return z_hat - z_meas; }
+};
+
+/// Vehicle heading implied by a Wheel-IMU attitude: yaw of the b x-axis - axle_sign * 90 deg.
+double wheel_vehicle_heading(const Mat3& C_BtoW, int axle_sign);
+
+WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in);
+
+}  // namespace wheelins

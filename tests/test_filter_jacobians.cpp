@@ -1,0 +1,157 @@
+// Every Jacobian of the filter against a finite-difference Jacobian of the
+// nonlinear function it linearises, with the error conventions of error_state.hpp:
+//   r_hat = r + dr, v_hat = v + dv, C_hat = exp(-[phi x]) C,
+//   omega_hat = omega + b_g + diag(omega) s_g,  f_hat = f + b_a + diag(f) s_a.
+#include <gtest/gtest.h>
+
+#include "wheelins/filter/error_model.hpp"
+#include "wheelins/filter/wheel_velocity.hpp"
+#include "wheelins/nav/earth.hpp"
+
+using namespace wheelins;
+
+namespace {
+
+// A wheel-like attitude: heading 37 deg (+90 for the axle), wheel angle 1.1 rad, small tilt.
+Mat3 wheel_attitude() { return dcm_from_euler(Vec3(1.1, 0.03, (37.0 + 90.0) * kDeg)); }
+
+struct NavTruth {
+  Vec3 p = Vec3(10.0, -4.0, 0.3);
+  Vec3 v = Vec3(1.1, 0.8, 0.02);
+  Mat3 C = wheel_attitude();
+  Vec3 omega = Vec3(-14.2, 0.3, -0.2);  // rad/s, b-frame
+  Vec3 f = Vec3(0.4, -3.1, -9.2);       // m/s^2, b-frame
+};
+
+// Perturbs the truth by an error vector dx (the estimate = truth (+) dx).
+struct Estimate {
+  Vec3 p, v, omega, f;
+  Mat3 C;
+};
+Estimate perturb(const NavTruth& t, const Vec21& dx) {
+  Estimate e;
+  e.p = t.p + dx.segment<3>(P);
+  e.v = t.v + dx.segment<3>(V);
+  e.C = dcm_from_rotvec(-dx.segment<3>(PHI)) * t.C;
+  e.omega = t.omega + dx.segment<3>(BG) + t.omega.cwiseProduct(dx.segment<3>(SG));
+  e.f = t.f + dx.segment<3>(BA) + t.f.cwiseProduct(dx.segment<3>(SA));
+  return e;
+}
+
+// The nonlinear w-frame dynamics of one state (the mechanization's continuous form).
+struct Derivs {
+  Vec3 p_dot, v_dot;
+  Mat3 C_dot;
+};
+Derivs dynamics(const Vec3& v, const Mat3& C, const Vec3& omega, const Vec3& f, const Vec3& w_ie,
+                double g) {
+  return {v, C * f + Vec3(0, 0, g) - 2.0 * w_ie.cross(v), C * skew(omega) - skew(w_ie) * C};
+}
+
+// Time derivative of the navigation error (rows P, V, PHI) for error dx.
+Eigen::Matrix<double, 9, 1> error_rate(const NavTruth& t, const Vec21& dx, const Vec3& w_ie) {
+  const Estimate e = perturb(t, dx);
+  const Derivs dt = dynamics(t.v, t.C, t.omega, t.f, w_ie, 9.8);
+  const Derivs de = dynamics(e.v, e.C, e.omega, e.f, w_ie, 9.8);
+  // phi from C_hat C^T = exp(-[phi x]); differentiate along the flow with a tiny step.
+  // Exact flow of C_dot = C [omega x] - [w_ie x] C for constant rates over h.
+  const double h = 1e-6;
+  const Mat3 C_hat_h = dcm_from_rotvec(-w_ie * h) * e.C * dcm_from_rotvec(e.omega * h);
+  const Mat3 C_h = dcm_from_rotvec(-w_ie * h) * t.C * dcm_from_rotvec(t.omega * h);
+  auto phi_of = [](const Mat3& Ch, const Mat3& Ct) {
+    Eigen::JacobiSVD<Mat3> svd(Ch * Ct.transpose(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+    return Vec3(-rotvec_from_quat(Quat(svd.matrixU() * svd.matrixV().transpose())));
+  };
+  Eigen::Matrix<double, 9, 1> r;
+  r.segment<3>(0) = de.p_dot - dt.p_dot;
+  r.segment<3>(3) = de.v_dot - dt.v_dot;
+  r.segment<3>(6) = (phi_of(C_hat_h, C_h) - phi_of(e.C, t.C)) / h;
+  return r;
+}
+
+}  // namespace
+
+TEST(FilterJacobian, ErrorDynamicsMatchFiniteDifference) {
+  const NavTruth t;
+  const Vec3 w_ie = earth::earth_rate_ned(30.5 * kDeg);
+  ProcessNoise q;
+  const Mat21 F = error_dynamics(t.C, t.omega, t.f, w_ie, q);
+  const double eps = 1e-6;
+  for (int j = 0; j < kStateDim; ++j) {
+    Vec21 dx = Vec21::Zero();
+    dx(j) = eps;
+    const auto plus = error_rate(t, dx, w_ie);
+    dx(j) = -eps;
+    const auto minus = error_rate(t, dx, w_ie);
+    const Eigen::Matrix<double, 9, 1> col = (plus - minus) / (2 * eps);
+    for (int i = 0; i < 9; ++i)
+      EXPECT_NEAR(col(i), F(i, j), 1e-5 * (1.0 + std::abs(F(i, j))))
+          << "F(" << i << "," << j << ")";
+  }
+  // Gauss-Markov rows: d(b)/dt = -b / tau.
+  EXPECT_DOUBLE_EQ(F(BG, BG), -1.0 / q.gyro_bias_tau);
+  EXPECT_DOUBLE_EQ(F(SA + 2, SA + 2), -1.0 / q.acc_sf_tau);
+}
+
+namespace {
+WheelVelocityInput wheel_input(const Estimate& e, double mean_omega_x) {
+  WheelVelocityInput in;
+  in.C_BtoW = e.C;
+  in.v_IinW = e.v;
+  in.omega_ib_b = e.omega;
+  in.omega_ie_inW = earth::earth_rate_ned(30.5 * kDeg);
+  in.lever_arm_inB = Vec3(0.012, -0.004, 0.006);
+  in.vehicle_roll = 0.02;
+  in.vehicle_pitch = -0.035;
+  in.axle_sign = 1;
+  in.radius = 0.097;
+  in.mean_omega_x = mean_omega_x;
+  return in;
+}
+}  // namespace
+
+TEST(FilterJacobian, WheelVelocityMatchesFiniteDifference) {
+  for (int axle_sign : {1, -1}) {
+    const NavTruth t;
+    const double mean_wx = -14.0;
+    auto residual = [&](const Vec21& dx) {
+      const Estimate e = perturb(t, dx);
+      // The window-mean speed sees the same residual gyro errors as the current sample.
+      const double mean = mean_wx + dx(BG) + mean_wx * dx(SG);
+      WheelVelocityInput in = wheel_input(e, mean);
+      in.axle_sign = axle_sign;
+      return wheel_velocity_model(in).innovation();
+    };
+    WheelVelocityInput in0 = wheel_input(perturb(t, Vec21::Zero()), mean_wx);
+    in0.axle_sign = axle_sign;
+    const WheelVelocityModel m = wheel_velocity_model(in0);
+    const double eps = 1e-6;
+    for (int j = 0; j < kStateDim; ++j) {
+      Vec21 dx = Vec21::Zero();
+      dx(j) = eps;
+      const Vec3 plus = residual(dx);
+      dx(j) = -eps;
+      const Vec3 minus = residual(dx);
+      const Vec3 col = (plus - minus) / (2 * eps);
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(col(i), m.H(i, j), 1e-6 * (1.0 + std::abs(m.H(i, j))))
+            << "axle " << axle_sign << " H(" << i << "," << j << ")";
+    }
+  }
+}
+
+TEST(FilterJacobian, WheelVelocityPredictsTrueWheelCentreVelocity) {
+  // A level wheel rolling forward at heading 37 deg with the IMU on the wheel centre:
+  // the prediction is [v, 0, 0] and the measured speed matches it.
+  const double radius = 0.1, speed = 1.5, heading = 37 * kDeg;
+  WheelVelocityInput in;
+  in.C_BtoW = rot_z(heading + kPi / 2) * rot_x(-0.7);
+  in.v_IinW = speed * Vec3(std::cos(heading), std::sin(heading), 0.0);
+  in.omega_ib_b = Vec3(-speed / radius, 0, 0);
+  in.radius = radius;
+  in.mean_omega_x = -speed / radius;
+  const auto m = wheel_velocity_model(in);
+  EXPECT_NEAR((m.z_hat - Vec3(speed, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(m.innovation().norm(), 0.0, 1e-12);
+  EXPECT_NEAR(wheel_vehicle_heading(in.C_BtoW, 1), heading, 1e-12);
+}
