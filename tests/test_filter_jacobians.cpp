@@ -104,9 +104,7 @@ WheelVelocityInput wheel_input(const Estimate& e, double mean_omega_x) {
   in.lever_arm_inB = Vec3(0.012, -0.004, 0.006);
   in.vehicle_roll = 0.02;
   in.vehicle_pitch = -0.035;
-  in.axle_sign = 1;
-  in.radius = 0.097;
-  in.mean_omega_x = mean_omega_x;
+  set_own_wheel_speed(in, 0.097, mean_omega_x);
   return in;
 }
 }  // namespace
@@ -121,10 +119,12 @@ TEST(FilterJacobian, WheelVelocityMatchesFiniteDifference) {
       const double mean = mean_wx + dx(BG) + mean_wx * dx(SG);
       WheelVelocityInput in = wheel_input(e, mean);
       in.axle_sign = axle_sign;
+      set_own_wheel_speed(in, 0.097, mean);
       return wheel_velocity_model(in).innovation();
     };
     WheelVelocityInput in0 = wheel_input(perturb(t, Vec21::Zero()), mean_wx);
     in0.axle_sign = axle_sign;
+    set_own_wheel_speed(in0, 0.097, mean_wx);
     const WheelVelocityModel m = wheel_velocity_model(in0);
     const double eps = 1e-6;
     for (int j = 0; j < kStateDim; ++j) {
@@ -149,8 +149,7 @@ TEST(FilterJacobian, WheelVelocityPredictsTrueWheelCentreVelocity) {
   in.C_BtoW = rot_z(heading + kPi / 2) * rot_x(-0.7);
   in.v_IinW = speed * Vec3(std::cos(heading), std::sin(heading), 0.0);
   in.omega_ib_b = Vec3(-speed / radius, 0, 0);
-  in.radius = radius;
-  in.mean_omega_x = -speed / radius;
+  set_own_wheel_speed(in, radius, -speed / radius);
   const auto m = wheel_velocity_model(in);
   EXPECT_NEAR((m.z_hat - Vec3(speed, 0, 0)).norm(), 0.0, 1e-12);
   EXPECT_NEAR(m.innovation().norm(), 0.0, 1e-12);

@@ -8,6 +8,12 @@ double wheel_vehicle_heading(const Mat3& C, int axle_sign) {
   return wrap_pi(yaw_from_dcm(C) - axle_sign * 0.5 * kPi);
 }
 
+void set_own_wheel_speed(WheelVelocityInput& in, double radius, double mean_omega_x) {
+  in.measured_speed = -in.axle_sign * radius * mean_omega_x;
+  in.dspeed_dbgx = -in.axle_sign * radius;
+  in.dspeed_dsgx = -in.axle_sign * radius * mean_omega_x;
+}
+
 WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   const Mat3& C = in.C_BtoW;
   const Vec3& l = in.lever_arm_inB;
@@ -23,7 +29,7 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
 
   WheelVelocityModel m;
   m.z_hat = C_WtoV * u;
-  m.z_meas = Vec3(-in.axle_sign * in.radius * in.mean_omega_x, 0.0, 0.0);
+  m.z_meas = Vec3(in.measured_speed, 0.0, 0.0);
 
   // d z_hat / d dv  (eq. 5, second term)
   m.H.block<3, 3>(0, V) = C_WtoV;
@@ -44,8 +50,8 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   m.H.block<3, 3>(0, BG) = Hbg;
   m.H.block<3, 3>(0, SG) = Hbg * in.omega_ib_b.asDiagonal();
   // The measured speed comes from the same compensated gyro: dz = z_hat - z_meas.
-  m.H(0, BG) += in.axle_sign * in.radius;
-  m.H(0, SG) += in.axle_sign * in.radius * in.mean_omega_x;
+  m.H(0, BG) -= in.dspeed_dbgx;
+  m.H(0, SG) -= in.dspeed_dsgx;
   return m;
 }
 

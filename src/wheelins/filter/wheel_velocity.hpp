@@ -5,7 +5,8 @@
 //   z_hat = C_w^v(psi_v) [ v^w + C_b^w (omega_nb^b x l^b) ],
 //   psi_v = yaw(C_b^w) - axle_sign * pi/2, vehicle roll/pitch given (0 on a plane,
 //   or shared by a Body-INS).
-// Measured: z = [ -axle_sign * r * mean(omega_x), 0, 0 ] (forward speed + NHC).
+// Measured: z = [ speed, 0, 0 ] (forward speed + NHC); the speed is this wheel's
+// -axle_sign * r * mean(omega_x), or a mean over several Wheel-IMUs (Section III).
 // Innovation dz = z_hat - z = H dx. H is exact to first order for the error
 // conventions of error_state.hpp: it keeps the full heading sensitivity of the
 // Wheel-IMU attitude (not only phi_z) and, because the speed comes from the
@@ -24,9 +25,16 @@ struct WheelVelocityInput {
   Vec3 lever_arm_inB = Vec3::Zero(); ///< IMU centre -> wheel centre [m]
   double vehicle_roll = 0.0, vehicle_pitch = 0.0;  ///< [rad]
   int axle_sign = 1;
-  double radius = 0.0;               ///< wheel radius [m]
-  double mean_omega_x = 0.0;         ///< compensated gyro x averaged over the speed window [rad/s]
+  double measured_speed = 0.0;       ///< forward wheel speed [m/s]
+  /// Sensitivity of measured_speed to this IMU's residual gyro-x bias and scale factor
+  /// (-axle_sign * r and -axle_sign * r * mean omega_x for its own speed, scaled by its
+  /// weight in a mean, zero when the speed comes from other IMUs only).
+  double dspeed_dbgx = 0.0;
+  double dspeed_dsgx = 0.0;
 };
+
+/// Fills the speed fields of `in` for a speed measured by this Wheel-IMU alone.
+void set_own_wheel_speed(WheelVelocityInput& in, double radius, double mean_omega_x);
 
 struct WheelVelocityModel {
   Vec3 z_hat = Vec3::Zero();   ///< predicted wheel-centre velocity in the v-frame

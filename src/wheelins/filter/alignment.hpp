@@ -1,0 +1,36 @@
+// Initial alignment from a static period (paper Section VI-A): roll and pitch
+// from the mean specific force, gyro bias from the mean angular rate (less the
+// earth rate), heading given (the paper takes it from the reference system).
+#pragma once
+
+#include "wheelins/nav/types.hpp"
+
+namespace wheelins {
+
+class StaticAccumulator {
+ public:
+  void add(const ImuSample& s) {
+    sum_dtheta_ += s.dtheta;
+    sum_dvel_ += s.dvel;
+    sum_dt_ += s.dt;
+    ++count_;
+  }
+  int count() const { return count_; }
+  double duration() const { return sum_dt_; }
+  Vec3 mean_omega() const { return sum_dtheta_ / sum_dt_; }
+  Vec3 mean_f() const { return sum_dvel_ / sum_dt_; }
+
+ private:
+  Vec3 sum_dtheta_ = Vec3::Zero(), sum_dvel_ = Vec3::Zero();
+  double sum_dt_ = 0.0;
+  int count_ = 0;
+};
+
+/// Roll and pitch of the b-frame from a static mean specific force (f^b = -C_n^b g^n).
+Vec3 level_from_specific_force(const Vec3& mean_f);
+
+/// C_b^n with the levelled roll/pitch and the yaw that gives the vehicle the requested
+/// heading through C_v^n = C_b^n C_v^b (C_BtoV: the IMU's attitude in the vehicle).
+Mat3 align_attitude(const Vec3& mean_f, double vehicle_heading, const Mat3& C_BtoV);
+
+}  // namespace wheelins

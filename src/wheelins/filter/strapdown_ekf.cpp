@@ -1,0 +1,46 @@
+#include "wheelins/filter/strapdown_ekf.hpp"
+
+namespace wheelins {
+
+void StrapdownEkf::initialize(const NavState& state, const ImuErrors& errors,
+                              const ProcessNoise& noise, const InitialUncertainty& init,
+                              const MechanizationOptions& mech) {
+  state_ = state;
+  errors_ = errors;
+  noise_ = noise;
+  mech_ = mech;
+  have_last_ = false;
+  P_.setZero();
+  P_.block<3, 3>(P, P).diagonal().setConstant(init.position * init.position);
+  P_.block<3, 3>(V, V).diagonal().setConstant(init.velocity * init.velocity);
+  P_.block<3, 3>(PHI, PHI).diagonal() << init.roll_pitch * init.roll_pitch,
+      init.roll_pitch * init.roll_pitch, init.heading * init.heading;
+  P_.block<3, 3>(BG, BG).diagonal().setConstant(noise.gyro_bias_std * noise.gyro_bias_std);
+  P_.block<3, 3>(BA, BA).diagonal().setConstant(noise.acc_bias_std * noise.acc_bias_std);
+  P_.block<3, 3>(SG, SG).diagonal().setConstant(noise.gyro_sf_std * noise.gyro_sf_std);
+  P_.block<3, 3>(SA, SA).diagonal().setConstant(noise.acc_sf_std * noise.acc_sf_std);
+  initialized_ = true;
+}
+
+void StrapdownEkf::propagate(const ImuSample& raw) {
+  const ImuSample cur = compensate(raw, errors_);
+  mechanize(mech_, have_last_ ? last_ : cur, cur, state_);
+  last_ = cur;
+  have_last_ = true;
+  const Mat21 F = error_dynamics(state_.C_ItoW(), cur.dtheta / cur.dt, cur.dvel / cur.dt,
+                                 mech_.omega_ie_inW, noise_);
+  propagate_covariance(P_, F, noise_, cur.dt);
+}
+
+void StrapdownEkf::feedback(const Vec21& dx) {
+  // r = r_hat - dr, v = v_hat - dv, C = exp([phi x]) C_hat, totals += residuals.
+  state_.p_IinW -= dx.segment<3>(P);
+  state_.v_IinW -= dx.segment<3>(V);
+  state_.q_ItoW = (quat_from_rotvec(dx.segment<3>(PHI)) * state_.q_ItoW).normalized();
+  errors_.bg += dx.segment<3>(BG);
+  errors_.ba += dx.segment<3>(BA);
+  errors_.sg += dx.segment<3>(SG);
+  errors_.sa += dx.segment<3>(SA);
+}
+
+}  // namespace wheelins

@@ -1,0 +1,107 @@
+#include "wheelins/filter/wheel_ins.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace wheelins {
+
+WheelIns::WheelIns(const ModuleSpec& module, const WheelInsOptions& opt,
+                   const MechanizationOptions& mech)
+    : module_(module),
+      opt_(opt),
+      mech_(mech),
+      C_StoB_(dcm_from_euler(module.mounting_rpy)),
+      axle_sign_(module.axle_sign) {
+  window_len_ = std::clamp(static_cast<int>(std::lround(opt.speed_window * module.rate_hz)), 1,
+                           kMaxWindow);
+}
+
+ImuSample WheelIns::to_body(const ImuSample& s) const {
+  ImuSample b = s;
+  b.dtheta = C_StoB_ * s.dtheta;
+  b.dvel = C_StoB_ * s.dvel;
+  return b;
+}
+
+void WheelIns::start(const StaticAccumulator& stat, double vehicle_heading, double t0) {
+  // Roll (the wheel angle) and pitch from the mean specific force; the b x-axis points
+  // along the axle, so the IMU yaw is the vehicle heading + axle_sign * 90 deg.
+  Vec3 rpy = level_from_specific_force(stat.mean_f());
+  rpy.z() = wrap_pi(vehicle_heading + axle_sign_ * 0.5 * kPi);
+  NavState s;
+  s.t = t0;
+  s.q_ItoW = Quat(dcm_from_euler(rpy)).normalized();
+  const Mat3 C = s.C_ItoW();
+  const Mat3 C_VtoW0 = rot_z(vehicle_heading);
+  s.p_IinW = C_VtoW0 * module_.p_inV - C * module_.lever_arm_inB;
+  ImuErrors e;
+  e.bg = stat.mean_omega() - C.transpose() * mech_.omega_ie_inW;
+  ekf_.initialize(s, e, ProcessNoise::from(module_.noise), opt_.init, mech_);
+  next_update_t_ = t0 + opt_.velocity_update_interval;
+  window_count_ = window_pos_ = 0;
+  window_sum_ = 0.0;
+}
+
+void WheelIns::propagate(const ImuSample& body_sample) {
+  ekf_.propagate(body_sample);
+  const double wx = ekf_.omega_ib_b().x();
+  if (window_count_ == window_len_) window_sum_ -= window_[window_pos_];
+  else ++window_count_;
+  window_[window_pos_] = wx;
+  window_sum_ += wx;
+  window_pos_ = (window_pos_ + 1) % window_len_;
+}
+
+double WheelIns::mean_omega_x() const {
+  return window_count_ ? window_sum_ / window_count_ : 0.0;
+}
+
+double WheelIns::wheel_speed() const { return -axle_sign_ * module_.wheel_radius * mean_omega_x(); }
+
+WheelVelocityInput WheelIns::own_velocity_input() const {
+  WheelVelocityInput in;
+  in.C_BtoW = ekf_.state().C_ItoW();
+  in.v_IinW = ekf_.state().v_IinW;
+  in.omega_ib_b = ekf_.omega_ib_b();
+  in.omega_ie_inW = mech_.omega_ie_inW;
+  in.lever_arm_inB = module_.lever_arm_inB;
+  in.vehicle_roll = vehicle_roll_;
+  in.vehicle_pitch = vehicle_pitch_;
+  in.axle_sign = axle_sign_;
+  set_own_wheel_speed(in, module_.wheel_radius, mean_omega_x());
+  return in;
+}
+
+UpdateReport WheelIns::velocity_update(WheelVelocityInput in) {
+  const WheelVelocityModel m = wheel_velocity_model(in);
+  const Mat3 R = opt_.velocity_std.cwiseAbs2().asDiagonal();
+  last_report_ = ekf_.update<3>(m.H, m.innovation(), R, opt_.gate);
+  // Re-schedule on the nominal grid (robust to a late epoch).
+  while (next_update_t_ <= ekf_.state().t + 1e-9) next_update_t_ += opt_.velocity_update_interval;
+  return last_report_;
+}
+
+Mat3 WheelIns::C_VtoW() const {
+  return rot_z(vehicle_heading()) * rot_y(vehicle_pitch_) * rot_x(vehicle_roll_);
+}
+
+Vec3 WheelIns::wheel_centre_inW() const {
+  const NavState& s = ekf_.state();
+  return s.p_IinW + s.C_ItoW() * module_.lever_arm_inB;
+}
+
+Vec3 WheelIns::reference_point_inW() const { return wheel_centre_inW() - C_VtoW() * module_.p_inV; }
+
+Vec3 WheelIns::reference_velocity_inW() const {
+  const NavState& s = ekf_.state();
+  const Mat3 C = s.C_ItoW();
+  const Vec3 omega_nb = ekf_.omega_ib_b() - C.transpose() * mech_.omega_ie_inW;
+  const Vec3 v_wc = s.v_IinW + C * omega_nb.cross(module_.lever_arm_inB);
+  // The vehicle turns with the wheel's angular rate less its spin about the axle.
+  const Vec3 omega_inW = C * omega_nb;
+  const Vec3 axle = C.col(0);
+  const Vec3 omega_vehicle = omega_inW - omega_inW.dot(axle) * axle;
+  return v_wc - omega_vehicle.cross(C_VtoW() * module_.p_inV);
+}
+
+}  // namespace wheelins

@@ -1,0 +1,85 @@
+// Wheel-INS: the navigation subsystem of one Wheel-IMU (paper Sections IV-V-A;
+// Niu et al. 2021). Strapdown EKF + wheel velocity/NHC updates at a fixed rate,
+// the wheel speed from the Wheel-IMU's own gyro, and the vehicle state (heading,
+// reference point) derived from the Wheel-IMU state.
+#pragma once
+
+#include <array>
+
+#include "wheelins/filter/alignment.hpp"
+#include "wheelins/filter/strapdown_ekf.hpp"
+#include "wheelins/filter/wheel_velocity.hpp"
+#include "wheelins/io/manifest.hpp"
+
+namespace wheelins {
+
+struct WheelInsOptions {
+  double velocity_update_interval = 0.5;       ///< [s]; the paper's 2 Hz
+  double speed_window = 0.05;                  ///< gyro-x averaging window for the speed [s]
+  Vec3 velocity_std = Vec3(0.03, 0.02, 0.02);  ///< forward, lateral, vertical [m/s] (Table 9)
+  double gate = 0.0;                           ///< innovation gate on the test ratio; 0 = off
+  InitialUncertainty init;
+};
+
+class WheelIns {
+ public:
+  static constexpr int kMaxWindow = 256;
+
+  WheelIns(const ModuleSpec& module, const WheelInsOptions& opt, const MechanizationOptions& mech);
+
+  /// Rotates a raw sample from the sensor axes into the ideal wheel b-frame (mounting angles).
+  ImuSample to_body(const ImuSample& sensor) const;
+
+  /// Aligns from the static mean (b-frame samples) and starts navigating at time t0 with
+  /// the reference point o at the w-frame origin and the given vehicle heading.
+  void start(const StaticAccumulator& stat, double vehicle_heading, double t0);
+
+  /// One IMU epoch (b-frame sample, see to_body).
+  void propagate(const ImuSample& body_sample);
+
+  /// True when the velocity update scheduled at the update rate is due at the current epoch.
+  bool velocity_update_due() const { return ekf_.state().t + 1e-9 >= next_update_t_; }
+  /// This wheel's forward speed from the mean compensated gyro x over the window [m/s].
+  double wheel_speed() const;
+  double mean_omega_x() const;
+  /// Velocity + NHC update with the given measurement input (see own_velocity_input()).
+  UpdateReport velocity_update(WheelVelocityInput in);
+  /// The input for an update with this wheel's own speed and the current vehicle roll/pitch.
+  WheelVelocityInput own_velocity_input() const;
+
+  /// Vehicle roll/pitch assumed in the velocity model (0: horizontal-plane assumption;
+  /// set by a Body-INS when one shares its attitude).
+  void set_vehicle_level(double roll, double pitch) {
+    vehicle_roll_ = roll;
+    vehicle_pitch_ = pitch;
+  }
+  double vehicle_heading() const { return wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_); }
+  Mat3 C_VtoW() const;
+  /// Wheel-centre position in the w-frame.
+  Vec3 wheel_centre_inW() const;
+  /// The reference point o (v-frame origin) in the w-frame, eq. (8): r_o = r_wc - C_v^w r_wc^v.
+  Vec3 reference_point_inW() const;
+  /// Velocity of o from the wheel-centre velocity and the vehicle yaw rate.
+  Vec3 reference_velocity_inW() const;
+
+  StrapdownEkf& ekf() { return ekf_; }
+  const StrapdownEkf& ekf() const { return ekf_; }
+  const ModuleSpec& module() const { return module_; }
+  const UpdateReport& last_report() const { return last_report_; }
+
+ private:
+  ModuleSpec module_;
+  WheelInsOptions opt_;
+  MechanizationOptions mech_;
+  Mat3 C_StoB_;
+  int axle_sign_;
+  StrapdownEkf ekf_;
+  double next_update_t_ = 0.0;
+  double vehicle_roll_ = 0.0, vehicle_pitch_ = 0.0;
+  std::array<double, kMaxWindow> window_{};
+  int window_len_ = 1, window_count_ = 0, window_pos_ = 0;
+  double window_sum_ = 0.0;
+  UpdateReport last_report_;
+};
+
+}  // namespace wheelins
