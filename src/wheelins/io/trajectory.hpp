@@ -1,6 +1,7 @@
 // A navigation result, one record per output epoch, and its file formats.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -24,5 +25,92 @@ struct TrajectoryRecord {
   Vec3 sg = Vec3::Zero(), sa = Vec3::Zero();  ///< scale-factor errors [-]
   Vec3 bg_std = Vec3::Zero(), ba_std = Vec3::Zero(), sg_std = Vec3::Zero(), sa_std = Vec3::Zero();
 };
+
+// ---------------------------------------------------------------------------
+// File formats.
+//
+// kCsv  (ours, written and read): one header row naming every column with its
+//       unit, then one row per epoch. SI units except angles and lat/lon in
+//       degrees, gyro biases in deg/h and scale factors in ppm:
+//         t_s, north_m, east_m, down_m, lat_deg, lon_deg, h_m,
+//         vn_m_s, ve_m_s, vd_m_s, roll_deg, pitch_deg, heading_deg,
+//         north_std_m .. down_std_m, vn_std_m_s .. vd_std_m_s,
+//         roll_std_deg, pitch_std_deg, heading_std_deg,
+//         bg_{x,y,z}_deg_h, ba_{x,y,z}_m_s2, sg_{x,y,z}_ppm, sa_{x,y,z}_ppm,
+//         and the same four groups with _std_ before the unit (bg_x_std_deg_h ...).
+//       Time, position, lat/lon/h, velocity and attitude are written as the
+//       shortest text that reads back to the identical double; the std and IMU
+//       error columns with 9 significant digits. The reader finds columns by
+//       header name (order free, unknown columns ignored); it needs t_s and either
+//       lat_deg/lon_deg/h_m or north_m/east_m/down_m.
+// kTum  (written and read): "t x y z qx qy qz qw" per line, x = north, y = east,
+//       z = down [m] in the local frame, q = the vehicle attitude C_v^n (Hamilton,
+//       rotating v-frame vectors into NED); '#' lines are comments.
+// kKml  (written only): one LineString of lon,lat,h, decimated to at most one
+//       point per `kml_min_interval` seconds and at most `kml_max_points` points.
+// kWheelInsTraj (read only): the public Wheel-INS result file `traj.txt`
+//       (i2Nav-WHU/Wheel-INS, src/main.cpp writeNavResult): whitespace-separated
+//       text, 10 values per line:
+//         t [s], pos x y z [m], vel x y z [m/s], roll pitch yaw [deg]
+//       position/velocity are in the flat local NED frame that program navigates
+//       in (origin: its initial position); the attitude is the Wheel-IMU's, whose yaw is
+//       the vehicle heading + 90 deg (roll spins with the wheel). The reader sets
+//       the vehicle heading to wrap(yaw - 90 deg) and leaves roll/pitch unknown.
+//       The frame's origin and initial heading are Wheel-INS's own, so evaluate
+//       these with alignment.
+// ---------------------------------------------------------------------------
+
+enum class TrajectoryFormat { kAuto, kCsv, kTum, kKml, kWheelInsTraj };
+
+/// "auto", "csv", "tum", "kml", "wheelins-traj" <-> TrajectoryFormat.
+TrajectoryFormat trajectory_format_from_name(const std::string& name);
+const char* trajectory_format_name(TrajectoryFormat format);
+
+/// Streaming writer of one trajectory file. Output goes to `file.partial` and is
+/// renamed into place by commit(); without commit() nothing appears. An existing
+/// file is refused (InputError) unless the writer was made with overwrite = true.
+class TrajectoryWriter {
+ public:
+  virtual ~TrajectoryWriter() = default;
+  virtual void write(const TrajectoryRecord& rec) = 0;
+  virtual void commit() = 0;
+  virtual std::uint64_t records() const = 0;  ///< records passed to write()
+};
+
+struct TrajectoryWriterOptions {
+  bool overwrite = false;
+  double kml_min_interval = 0.5;          ///< [s] between KML points
+  std::size_t kml_max_points = 20000;     ///< hard cap on KML points (>= 2)
+  std::string kml_name = "wheelins";      ///< KML document/placemark name
+};
+
+/// A writer for `format` (kCsv, kTum or kKml; others throw InputError).
+std::unique_ptr<TrajectoryWriter> make_trajectory_writer(
+    TrajectoryFormat format, const std::filesystem::path& file,
+    const TrajectoryWriterOptions& options = {});
+
+/// A trajectory read from a file, with what the format actually provided.
+struct TrajectoryData {
+  std::filesystem::path file;
+  TrajectoryFormat format = TrajectoryFormat::kCsv;
+  bool has_lla = false;       ///< lla is valid (p_inN also, in the writer's own frame)
+  bool has_ned = false;       ///< p_inN is valid
+  bool has_velocity = false;
+  bool has_roll_pitch = false;
+  bool has_heading = false;   ///< rpy.z() is the vehicle heading
+  bool has_pos_std = false;   ///< p_std is valid
+  std::vector<TrajectoryRecord> records;
+};
+
+/// Guesses the format from the extension and the first non-comment line:
+/// .csv or a header with letters and commas -> kCsv; 8 numbers -> kTum;
+/// 10 numbers -> kWheelInsTraj; .kml -> InputError (output only).
+TrajectoryFormat detect_trajectory_format(const std::filesystem::path& file);
+
+/// Reads a trajectory; validates (finite time/position, strictly increasing time,
+/// the expected number of columns) and throws InputError naming the file and the
+/// line (1-based) of the first problem.
+TrajectoryData read_trajectory(const std::filesystem::path& file,
+                               TrajectoryFormat format = TrajectoryFormat::kAuto);
 
 }  // namespace wheelins

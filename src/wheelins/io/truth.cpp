@@ -1,0 +1,224 @@
+#include "wheelins/io/truth.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <system_error>
+
+#include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/binary.hpp"
+#include "wheelins/nav/types.hpp"
+
+namespace wheelins {
+namespace {
+
+constexpr int kCols11 = 11;
+constexpr int kCols5 = 5;
+constexpr double kWeekSeconds = 604800.0;
+constexpr std::uint64_t kProbeRows = 256;
+
+std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+std::string where(const std::filesystem::path& file, std::uint64_t record) {
+  return quote(file) + ": record " + std::to_string(record) + ": ";
+}
+
+std::string num(double v) {
+  std::string s;
+  append_double(s, v, 12);
+  return s;
+}
+
+bool lat_lon_ok(double lat_deg, double lon_deg) {
+  return std::abs(lat_deg) <= 90.0 && std::abs(lon_deg) <= 180.0;
+}
+
+// Content test of the first rows read as `ncols` columns (see truth.hpp).
+bool plausible(const std::filesystem::path& file, int ncols) {
+  BinaryRowReader rd(file, ncols);
+  const std::uint64_t n = std::min<std::uint64_t>(rd.rows(), kProbeRows);
+  double prev_week = -1.0, prev_t = -INFINITY;
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const double* r = rd.next();
+    if (ncols == kCols11) {
+      for (int c = 0; c < kCols11; ++c)
+        if (!std::isfinite(r[c])) return false;
+      const double week = r[0];
+      if (week < 0.0 || week >= 1e5 || week != std::floor(week) || week < prev_week) return false;
+      // Within one week t must increase; a week change may reset it.
+      if (week == prev_week && !(r[1] > prev_t)) return false;
+      if (!lat_lon_ok(r[2], r[3])) return false;
+      prev_week = week;
+      prev_t = r[1];
+    } else {
+      for (int c = 0; c < 4; ++c)
+        if (!std::isfinite(r[c])) return false;
+      if (!(r[0] > prev_t)) return false;
+      if (!lat_lon_ok(r[1], r[2])) return false;
+      prev_t = r[0];
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+TruthLayout truth_layout_from_name(const std::string& name) {
+  if (name == "auto") return TruthLayout::kAuto;
+  if (name == "gins11" || name == "11") return TruthLayout::kGins11;
+  if (name == "pos5" || name == "5") return TruthLayout::kPos5;
+  throw InputError("unknown truth layout '" + name + "' (expected auto, gins11 or pos5)");
+}
+
+const char* truth_layout_name(TruthLayout layout) {
+  switch (layout) {
+    case TruthLayout::kAuto: return "auto";
+    case TruthLayout::kGins11: return "gins11";
+    case TruthLayout::kPos5: return "pos5";
+  }
+  return "?";
+}
+
+TruthLayout detect_truth_layout(const std::filesystem::path& file) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(file, ec);
+  if (ec || !std::filesystem::exists(st)) throw InputError(quote(file) + ": file not found");
+  if (std::filesystem::is_directory(st))
+    throw InputError(quote(file) + ": is a directory, expected a truth file (GINS.bin)");
+  const auto bytes = std::filesystem::file_size(file, ec);
+  if (ec) throw InputError(quote(file) + ": cannot read size: " + ec.message());
+  if (bytes == 0) throw InputError(quote(file) + ": empty truth file");
+  const bool fits11 = bytes % (8 * kCols11) == 0;
+  const bool fits5 = bytes % (8 * kCols5) == 0;
+  if (!fits11 && !fits5)
+    throw InputError(quote(file) + ": size " + std::to_string(bytes) +
+                     " bytes fits neither truth layout (11 float64 = 88 bytes per record: "
+                     "gps_week, t, lat, lon, h, vn, ve, vd, roll, pitch, yaw; or 5 float64 = "
+                     "40 bytes: t, lat, lon, h, unused); truncated or not a truth file");
+  if (fits11 && !fits5) return TruthLayout::kGins11;
+  if (fits5 && !fits11) return TruthLayout::kPos5;
+  const bool ok11 = plausible(file, kCols11);
+  const bool ok5 = plausible(file, kCols5);
+  if (ok11 && !ok5) return TruthLayout::kGins11;
+  if (ok5 && !ok11) return TruthLayout::kPos5;
+  throw InputError(quote(file) + ": size " + std::to_string(bytes) +
+                   " bytes fits both truth layouts and the content " +
+                   (ok11 ? "looks valid in both" : "is valid in neither") +
+                   " (11 columns: integer GPS week, increasing time, lat/lon; 5 columns: "
+                   "increasing time, lat/lon); give the layout explicitly (gins11 or pos5)");
+}
+
+TruthData read_truth(const std::filesystem::path& file, TruthLayout layout) {
+  if (layout == TruthLayout::kAuto) layout = detect_truth_layout(file);
+  const int ncols = layout == TruthLayout::kGins11 ? kCols11 : kCols5;
+  BinaryRowReader rd(file, ncols);
+  if (rd.rows() == 0) throw InputError(quote(file) + ": empty truth file");
+
+  TruthData out;
+  out.file = file;
+  out.layout = layout;
+  out.has_velocity_attitude = layout == TruthLayout::kGins11;
+  out.records.reserve(rd.rows());
+
+  double first_week = 0.0, prev_t = -INFINITY;
+  static const char* const kNames11[kCols11] = {"gps_week", "t",  "lat",  "lon",   "h",  "vn",
+                                                "ve",       "vd", "roll", "pitch", "yaw"};
+  static const char* const kNames5[4] = {"t", "lat", "lon", "h"};
+  while (const double* r = rd.next()) {
+    const std::uint64_t i = rd.index();
+    const int checked = layout == TruthLayout::kGins11 ? kCols11 : 4;
+    for (int c = 0; c < checked; ++c)
+      if (!std::isfinite(r[c]))
+        throw InputError(where(file, i) + "column " + std::to_string(c) + " (" +
+                         (layout == TruthLayout::kGins11 ? kNames11[c] : kNames5[c]) +
+                         ") is " + num(r[c]) + "; values must be finite");
+    TruthRecord rec;
+    double lat_deg, lon_deg;
+    if (layout == TruthLayout::kGins11) {
+      const double week = r[0];
+      if (week < 0.0 || week != std::floor(week))
+        throw InputError(where(file, i) + "GPS week " + num(week) +
+                         " is not a non-negative integer (is this an 11-column GINS file?)");
+      if (i == 0) {
+        first_week = week;
+        out.gps_week = week;
+      }
+      if (week < first_week)
+        throw InputError(where(file, i) + "GPS week " + num(week) +
+                         " is before the first record's week " + num(first_week));
+      rec.t = r[1] + kWeekSeconds * (week - first_week);
+      lat_deg = r[2];
+      lon_deg = r[3];
+      rec.lla.h = r[4];
+      rec.v_ned = Vec3(r[5], r[6], r[7]);
+      rec.rpy = Vec3(r[8], r[9], r[10]) * kDeg;
+    } else {
+      rec.t = r[0];
+      lat_deg = r[1];
+      lon_deg = r[2];
+      rec.lla.h = r[3];
+    }
+    if (!lat_lon_ok(lat_deg, lon_deg))
+      throw InputError(where(file, i) + "latitude " + num(lat_deg) + " / longitude " +
+                       num(lon_deg) + " deg out of range (|lat| <= 90, |lon| <= 180)");
+    if (!(rec.t > prev_t))
+      throw InputError(where(file, i) + "time " + num(rec.t) +
+                       " s does not increase (previous record: " + num(prev_t) + " s)");
+    prev_t = rec.t;
+    rec.lla.lat = lat_deg * kDeg;
+    rec.lla.lon = lon_deg * kDeg;
+    out.records.push_back(rec);
+  }
+  return out;
+}
+
+TruthWriter::TruthWriter(const std::filesystem::path& file, bool overwrite, double gps_week)
+    : file_(file), overwrite_(overwrite), gps_week_(gps_week) {
+  if (!std::isfinite(gps_week) || gps_week < 0.0 || gps_week != std::floor(gps_week))
+    throw InputError(quote(file) + ": GPS week " + num(gps_week) +
+                     " is not a non-negative integer");
+  check_output_target(file, overwrite);
+  out_ = std::make_unique<BinaryRowWriter>(file, kCols11);
+}
+
+TruthWriter::~TruthWriter() = default;
+
+void TruthWriter::write(const TruthRecord& rec) {
+  const double row[kCols11] = {gps_week_,
+                               rec.t,
+                               rec.lla.lat / kDeg,
+                               rec.lla.lon / kDeg,
+                               rec.lla.h,
+                               rec.v_ned.x(),
+                               rec.v_ned.y(),
+                               rec.v_ned.z(),
+                               rec.rpy.x() / kDeg,
+                               rec.rpy.y() / kDeg,
+                               rec.rpy.z() / kDeg};
+  for (double v : row)
+    if (!std::isfinite(v))
+      throw InputError(where(file_, rows_) + "cannot write a non-finite truth value");
+  if (!lat_lon_ok(row[2], row[3]))
+    throw InputError(where(file_, rows_) + "latitude/longitude out of range");
+  if (rows_ > 0 && !(rec.t > last_t_))
+    throw InputError(where(file_, rows_) + "time " + num(rec.t) +
+                     " s does not increase (previous record: " + num(last_t_) + " s)");
+  out_->write(row);
+  last_t_ = rec.t;
+  ++rows_;
+}
+
+void TruthWriter::commit() {
+  // BinaryRowWriter renames unconditionally; refuse a target that appeared meanwhile.
+  check_output_target(file_, overwrite_);
+  out_->commit();
+}
+
+void write_truth(const std::filesystem::path& file, const std::vector<TruthRecord>& records,
+                 bool overwrite, double gps_week) {
+  TruthWriter w(file, overwrite, gps_week);
+  for (const auto& r : records) w.write(r);
+  w.commit();
+}
+
+}  // namespace wheelins
