@@ -4,7 +4,9 @@
 //   omega_hat = omega + b_g + diag(omega) s_g,  f_hat = f + b_a + diag(f) s_a.
 #include <gtest/gtest.h>
 
+#include "wheelins/filter/body_velocity.hpp"
 #include "wheelins/filter/error_model.hpp"
+#include "wheelins/filter/position_constraint.hpp"
 #include "wheelins/filter/wheel_velocity.hpp"
 #include "wheelins/nav/earth.hpp"
 
@@ -154,4 +156,86 @@ TEST(FilterJacobian, WheelVelocityPredictsTrueWheelCentreVelocity) {
   EXPECT_NEAR((m.z_hat - Vec3(speed, 0, 0)).norm(), 0.0, 1e-12);
   EXPECT_NEAR(m.innovation().norm(), 0.0, 1e-12);
   EXPECT_NEAR(wheel_vehicle_heading(in.C_BtoW, 1), heading, 1e-12);
+}
+
+TEST(FilterJacobian, BodyVelocityMatchesFiniteDifference) {
+  NavTruth t;
+  t.C = dcm_from_euler(Vec3(0.02, -0.04, 1.3));
+  t.omega = Vec3(0.01, -0.02, 0.35);
+  BodyVelocityInput base;
+  base.omega_ie_inW = earth::earth_rate_ned(30.5 * kDeg);
+  base.C_BtoV = dcm_from_euler(Vec3(0.5, -0.8, 1.2) * kDeg);
+  base.lever_arm_inB = Vec3(-0.25, 0.16, 0.2);
+  base.measured_speed = 1.3;
+  auto model_at = [&](const Vec21& dx) {
+    const Estimate e = perturb(t, dx);
+    BodyVelocityInput in = base;
+    in.C_BtoW = e.C;
+    in.v_IinW = e.v;
+    in.omega_ib_b = e.omega;
+    return body_velocity_model(in);
+  };
+  const auto m = model_at(Vec21::Zero());
+  const double eps = 1e-6;
+  for (int j = 0; j < kStateDim; ++j) {
+    Vec21 dx = Vec21::Zero();
+    dx(j) = eps;
+    const Vec3 plus = model_at(dx).innovation();
+    dx(j) = -eps;
+    const Vec3 col = (plus - model_at(dx).innovation()) / (2 * eps);
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(col(i), m.H(i, j), 1e-6 * (1.0 + std::abs(m.H(i, j)))) << "H(" << i << "," << j << ")";
+  }
+}
+
+TEST(FilterJacobian, PositionConstraintMatchesFiniteDifference) {
+  for (bool wheel : {true, false}) {
+    NavTruth t;
+    if (!wheel) t.C = dcm_from_euler(Vec3(0.02, -0.04, 1.3));
+    ReferencePointInput base;
+    base.wheel = wheel;
+    base.lever_arm_inB = wheel ? Vec3(0.004, -0.003, 0.005) : Vec3::Zero();
+    base.p_inV = wheel ? Vec3(0.0, -0.165, 0.0) : Vec3(0.2, 0.02, -0.15);
+    base.vehicle_roll = 0.03;
+    base.vehicle_pitch = -0.02;
+    base.C_BtoV = dcm_from_euler(Vec3(0.5, -0.8, 1.2) * kDeg);
+    auto model_at = [&](const Vec21& dx) {
+      const Estimate e = perturb(t, dx);
+      ReferencePointInput in = base;
+      in.C_BtoW = e.C;
+      in.p_IinW = e.p;
+      return reference_point_model(in);
+    };
+    const auto m = model_at(Vec21::Zero());
+    const double eps = 1e-6;
+    for (int j = 0; j < kStateDim; ++j) {
+      Vec21 dx = Vec21::Zero();
+      dx(j) = eps;
+      const Vec3 plus = model_at(dx).r_o;
+      dx(j) = -eps;
+      const Vec3 col = (plus - model_at(dx).r_o) / (2 * eps);
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(col(i), m.H(i, j), 1e-6 * (1.0 + std::abs(m.H(i, j))))
+            << (wheel ? "wheel" : "body") << " H(" << i << "," << j << ")";
+    }
+  }
+}
+
+TEST(FilterJacobian, ReferencePointOfLevelWheelAndBody) {
+  // Vehicle at (5, 2) heading 30 deg; the left wheel centre is at v (0, -0.165, 0).
+  const double psi = 30 * kDeg;
+  const Vec3 o(5, 2, 0);
+  ReferencePointInput w;
+  w.C_BtoW = rot_z(psi + kPi / 2) * rot_x(-0.4);
+  w.lever_arm_inB = Vec3(0.003, 0.002, -0.004);
+  w.p_inV = Vec3(0, -0.165, 0);
+  w.p_IinW = o + rot_z(psi) * w.p_inV - w.C_BtoW * w.lever_arm_inB;
+  EXPECT_NEAR((reference_point_model(w).r_o - o).norm(), 0.0, 1e-12);
+  ReferencePointInput b;
+  b.wheel = false;
+  b.C_BtoV = dcm_from_euler(Vec3(0.01, 0.02, 0.03));
+  b.C_BtoW = rot_z(psi) * b.C_BtoV;
+  b.p_inV = Vec3(0.2, 0.0, -0.15);
+  b.p_IinW = o + rot_z(psi) * b.p_inV;
+  EXPECT_NEAR((reference_point_model(b).r_o - o).norm(), 0.0, 1e-12);
 }

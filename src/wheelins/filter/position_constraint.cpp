@@ -1,0 +1,33 @@
+#include "wheelins/filter/position_constraint.hpp"
+
+#include "wheelins/filter/wheel_velocity.hpp"
+
+namespace wheelins {
+
+ReferencePointModel reference_point_model(const ReferencePointInput& in) {
+  const Mat3& C = in.C_BtoW;
+  ReferencePointModel m;
+  m.H.block<3, 3>(0, P) = Mat3::Identity();
+  if (in.wheel) {
+    const double psi = wheel_vehicle_heading(C, in.axle_sign);
+    const Mat3 Rz = rot_z(psi), Ryx = rot_y(in.vehicle_pitch) * rot_x(in.vehicle_roll);
+    const Vec3 a = Ryx * in.p_inV;            // so that C_v^w r^v = Rz(psi) a
+    const Vec3 Cl = C * in.lever_arm_inB;
+    m.r_o = in.p_IinW + Cl - Rz * a;
+    // (I - [phi x]) C l = C l + [(C l) x] phi; the heading enters through psi(C_b^w).
+    const Vec3 c1 = C.col(0);
+    const double h2 = c1.x() * c1.x() + c1.y() * c1.y();
+    const Eigen::RowVector3d dpsi_dphi =
+        Eigen::RowVector3d(-c1.y() / h2, c1.x() / h2, 0.0) * skew(c1);
+    const Vec3 dRa_dpsi = Rz * skew(Vec3::UnitZ()) * a;
+    m.H.block<3, 3>(0, PHI) = skew(Cl) - dRa_dpsi * dpsi_dphi;
+  } else {
+    // r_o = r_b - C_b^w C_v^b r_b^v; (I - [phi x]) C_v^w r = C_v^w r + [(C_v^w r) x] phi.
+    const Vec3 Cr = C * in.C_BtoV.transpose() * in.p_inV;
+    m.r_o = in.p_IinW - Cr;
+    m.H.block<3, 3>(0, PHI) = -skew(Cr);
+  }
+  return m;
+}
+
+}  // namespace wheelins
