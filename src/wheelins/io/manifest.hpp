@@ -7,10 +7,12 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "wheelins/io/diagnostics.hpp"
 #include "wheelins/nav/earth.hpp"
 
 namespace wheelins {
@@ -77,8 +79,30 @@ struct Manifest {
 };
 
 /// Reads and validates a manifest; throws InputError naming the file and the key.
+/// Warnings (unknown keys, with the closest known key) are printed on stderr.
 Manifest load_manifest(const std::filesystem::path& file);
+/// The same, with warnings sent to `warn` (nothing is printed; `warn` may be empty).
+Manifest load_manifest(const std::filesystem::path& file, const WarningSink& warn);
 /// Writes a manifest in human units (written to a temporary name, then moved into place).
+/// Relative data-file paths are rewritten so that they still name the same files
+/// when `file` is in another directory than `m.path`.
 void save_manifest(const Manifest& m, const std::filesystem::path& file);
+
+/// Extra comments for the YAML text: lines at the top, and end-of-line comments keyed
+/// by key path ("initial.heading_deg", "modules[1].wheel_radius_m", "modules[1]").
+struct ManifestAnnotations {
+  std::vector<std::string> header;
+  std::map<std::string, std::string> comments;
+};
+void save_manifest(const Manifest& m, const std::filesystem::path& file,
+                   const ManifestAnnotations& notes);
+/// The YAML text save_manifest writes; relative paths are written for a manifest in `dir`.
+std::string manifest_to_yaml(const Manifest& m, const std::filesystem::path& dir,
+                             const ManifestAnnotations& notes = {});
+
+/// Manifest text spellings of the enums ("wheel", "rate", "binary", ...).
+const char* to_string(ModuleKind k);
+const char* to_string(SampleFormat f);
+const char* to_string(FileLayout l);
 
 }  // namespace wheelins

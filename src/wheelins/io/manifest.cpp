@@ -1,0 +1,635 @@
+#include "wheelins/io/manifest.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include "wheelins/io/text_util.hpp"
+#include "wheelins/nav/types.hpp"
+
+namespace wheelins {
+namespace fs = std::filesystem;
+using io_detail::format_double;
+using io_detail::quote;
+
+namespace {
+
+constexpr const char* kFormatId = "wheelins-manifest-1";
+
+// Human units on disk, SI in memory. A number as people write it (up to 17 significant
+// digits) converts as si = x * mul / div in double arithmetic -- the same expression
+// as the defaults in ImuNoise (0.24 * kDeg / 60.0), so defaults print as written.
+// Not every double is reachable that way; for those save_manifest writes a longer
+// text (more than 17 significant digits), which converts in long double precision
+// (si = round(x * factor)), so that save -> load is always bit-identical.
+struct Unit {
+  double mul, div;
+  long double factor;
+};
+constexpr long double kPiL = 3.141592653589793238462643383279502884L;
+constexpr Unit kOne{1.0, 1.0, 1.0L};                                // m, s, Hz, m/s^2
+constexpr Unit kDegU{kDeg, 1.0, kPiL / 180.0L};                     // deg -> rad
+constexpr Unit kArwU{kDeg, 60.0, kPiL / 180.0L / 60.0L};            // deg/sqrt(h) -> rad/sqrt(s)
+constexpr Unit kVrwU{1.0, 60.0, 1.0L / 60.0L};                      // m/s/sqrt(h) -> m/s/sqrt(s)
+constexpr Unit kDegPerHourU{kDeg, 3600.0, kPiL / 180.0L / 3600.0L};  // deg/h -> rad/s
+constexpr Unit kPpmU{1.0, 1e6, 1e-6L};                              // ppm -> [-]
+constexpr Unit kHourU{3600.0, 1.0, 3600.0L};                        // h -> s
+
+int significant_digits(std::string_view text) {
+  int n = 0;
+  bool started = false;
+  for (char c : text) {
+    if (c == 'e' || c == 'E') break;
+    if (c < '0' || c > '9') continue;
+    if (c != '0') started = true;
+    if (started) ++n;
+  }
+  return n;
+}
+
+/// The SI value of a human-unit text, or nullopt if the text is not a number.
+std::optional<double> human_to_si(std::string_view text, Unit u) {
+  if (u.factor == 1.0L) return io_detail::parse_double(text);
+  if (significant_digits(text) > 17) {
+    const auto x = io_detail::parse_long_double(text);
+    if (!x) return std::nullopt;
+    return static_cast<double>(*x * u.factor);
+  }
+  const auto x = io_detail::parse_double(text);
+  if (!x) return std::nullopt;
+  return *x * u.mul / u.div;
+}
+
+/// The shortest human-unit text that human_to_si() maps back to exactly `si`.
+std::string si_to_human(double si, Unit u) {
+  if (u.factor == 1.0L || si == 0.0 || !std::isfinite(si)) return format_double(si);
+  // Prefer the shortest text among the doubles next to the quotient.
+  const double h = si * u.div / u.mul;
+  std::string best;
+  double up = h, down = h;
+  for (int i = 0; i < 8; ++i) {
+    for (double c : {up, down}) {
+      std::string t = format_double(c);
+      if ((best.empty() || t.size() < best.size()) && human_to_si(t, u) == si) best = std::move(t);
+    }
+    up = std::nextafter(up, HUGE_VAL);
+    down = std::nextafter(down, -HUGE_VAL);
+  }
+  if (!best.empty()) return best;
+  // Otherwise a long text, converted in long double precision (always reaches si).
+  const long double hl = static_cast<long double>(si) / u.factor;
+  long double lup = hl, ldown = hl;
+  char buf[96];
+  for (int i = 0; i < 64; ++i) {
+    for (long double c : {lup, ldown}) {
+      std::snprintf(buf, sizeof buf, "%.*Le", LDBL_DECIMAL_DIG - 1, c);
+      if (human_to_si(buf, u) == si) return buf;
+    }
+    lup = std::nextafter(lup, HUGE_VALL);
+    ldown = std::nextafter(ldown, -HUGE_VALL);
+  }
+  return format_double(h);  // within an ulp of si; not reached in practice
+}
+
+const std::vector<std::string> kTopKeys = {"format",         "name",         "truth",
+                                           "odometer",       "static_period_s", "initial",
+                                           "gravity_m_s2",   "earth_rotation", "vehicle",
+                                           "modules"};
+const std::vector<std::string> kInitialKeys = {"lat_deg", "lon_deg", "h_m", "heading_deg"};
+const std::vector<std::string> kVehicleKeys = {"track_m"};
+const std::vector<std::string> kModuleKeys = {
+    "name",          "kind",          "group",        "chip",      "file",
+    "format",        "layout",        "rate_hz",      "time_offset_s", "position_v_m",
+    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "wheel_radius_m", "noise"};
+
+/// One noise key: its name, its unit factor and the ImuNoise member it fills.
+struct NoiseKey {
+  const char* key;
+  Unit unit;
+  double ImuNoise::*member;
+};
+const NoiseKey kNoiseKeys[] = {
+    {"gyro_arw_deg_sqrt_h", kArwU, &ImuNoise::gyro_arw},
+    {"acc_vrw_m_s_sqrt_h", kVrwU, &ImuNoise::acc_vrw},
+    {"gyro_bias_deg_h", kDegPerHourU, &ImuNoise::gyro_bias_std},
+    {"acc_bias_m_s2", kOne, &ImuNoise::acc_bias_std},
+    {"gyro_sf_ppm", kPpmU, &ImuNoise::gyro_sf_std},
+    {"acc_sf_ppm", kPpmU, &ImuNoise::acc_sf_std},
+    {"gyro_bias_tau_h", kHourU, &ImuNoise::gyro_bias_tau},
+    {"acc_bias_tau_h", kHourU, &ImuNoise::acc_bias_tau},
+    {"gyro_sf_tau_h", kHourU, &ImuNoise::gyro_sf_tau},
+    {"acc_sf_tau_h", kHourU, &ImuNoise::acc_sf_tau},
+};
+
+std::vector<std::string> noise_key_names() {
+  std::vector<std::string> v;
+  for (const auto& k : kNoiseKeys) v.emplace_back(k.key);
+  return v;
+}
+
+std::string join(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+std::string index_path(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Map: return "a mapping";
+    case YAML::NodeType::Null: return "nothing (empty value)";
+    default: return "nothing";
+  }
+}
+
+/// Reads one manifest, remembering the file name for every message.
+class Loader {
+ public:
+  Loader(const fs::path& file, const WarningSink& warn) : file_(file), warn_(warn) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what,
+                         const YAML::Node* at = nullptr) const {
+    std::string msg = quote(file_) + ": " + (key.empty() ? "" : key + ": ") + what;
+    if (at && at->IsDefined() && !at->Mark().is_null())
+      msg += " (line " + std::to_string(at->Mark().line + 1) + ")";
+    throw InputError(msg);
+  }
+
+  void require_map(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsMap()) fail(path, "expected a mapping (key: value lines), got " + describe(n), &n);
+  }
+
+  /// Rejects duplicate keys and warns about unknown ones (naming the closest known key).
+  void check_keys(const YAML::Node& map, const std::string& path,
+                  const std::vector<std::string>& known) const {
+    std::set<std::string> seen;
+    for (const auto& kv : map) {
+      if (!kv.first.IsScalar())
+        fail(path, "keys must be plain names, got " + describe(kv.first), &kv.first);
+      const std::string key = kv.first.Scalar();
+      if (!seen.insert(key).second) fail(join(path, key), "duplicate key", &kv.first);
+      if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+      // Closest by edit distance; a known key that extends the unknown one (a forgotten
+      // unit suffix: "wheel_radius" -> "wheel_radius_m") wins over any other.
+      std::string best;
+      std::pair<int, std::size_t> best_score{2, 0};
+      for (const auto& k : known) {
+        const bool extends = k.size() > key.size() && k.compare(0, key.size(), key) == 0;
+        const std::pair<int, std::size_t> score{extends ? 0 : 1, io_detail::edit_distance(key, k)};
+        if (score < best_score) best_score = score, best = k;
+      }
+      if (warn_) {
+        std::string msg = quote(file_) + ": " + join(path, key) + ": unknown key ignored";
+        if (!kv.first.Mark().is_null()) msg += " (line " + std::to_string(kv.first.Mark().line + 1) + ")";
+        msg += "; did you mean '" + best + "'?";
+        warn_(msg);
+      }
+    }
+  }
+
+  /// The value of `key` in `map`, or an undefined node if it is absent or null.
+  static YAML::Node get(const YAML::Node& map, const std::string& key) {
+    const YAML::Node& cmap = map;
+    YAML::Node v = cmap[key];
+    if (!v.IsDefined() || v.IsNull()) return YAML::Node(YAML::NodeType::Undefined);
+    return v;
+  }
+
+  YAML::Node required(const YAML::Node& map, const std::string& path, const std::string& key) const {
+    YAML::Node v = get(map, key);
+    if (!v.IsDefined()) {
+      const YAML::Node& cmap = map;
+      if (cmap[key].IsDefined())
+        fail(join(path, key), "required value is empty", &map);
+      fail(path, "missing required key '" + key + "'", &map);
+    }
+    return v;
+  }
+
+  double number(const YAML::Node& v, const std::string& path, Unit u = kOne) const {
+    if (!v.IsScalar()) fail(path, "expected a number, got " + describe(v), &v);
+    const auto x = human_to_si(v.Scalar(), u);
+    if (!x) fail(path, "expected a number, got " + describe(v), &v);
+    if (!std::isfinite(*x)) fail(path, "expected a finite number, got " + describe(v), &v);
+    return *x;
+  }
+
+  std::string text(const YAML::Node& v, const std::string& path) const {
+    if (!v.IsScalar()) fail(path, "expected a text value, got " + describe(v), &v);
+    if (v.Scalar().empty()) fail(path, "expected a non-empty text value", &v);
+    return v.Scalar();
+  }
+
+  bool boolean(const YAML::Node& v, const std::string& path) const {
+    if (v.IsScalar()) {
+      std::string s = v.Scalar();
+      std::transform(s.begin(), s.end(), s.begin(),
+                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      if (s == "true" || s == "yes" || s == "on") return true;
+      if (s == "false" || s == "no" || s == "off") return false;
+    }
+    fail(path, "expected true or false, got " + describe(v), &v);
+  }
+
+  Vec3 vec3(const YAML::Node& v, const std::string& path, Unit u = kOne) const {
+    if (!v.IsSequence() || v.size() != 3)
+      fail(path, "expected a list of 3 numbers [x, y, z], got " +
+                     (v.IsSequence() ? "a list of " + std::to_string(v.size()) : describe(v)),
+           &v);
+    Vec3 out;
+    for (std::size_t i = 0; i < 3; ++i) out[static_cast<int>(i)] = number(v[i], index_path(path, i), u);
+    return out;
+  }
+
+  template <class E>
+  E choice(const YAML::Node& v, const std::string& path,
+           const std::vector<std::pair<std::string, E>>& options) const {
+    if (v.IsScalar())
+      for (const auto& [name, value] : options)
+        if (v.Scalar() == name) return value;
+    std::string list;
+    for (const auto& o : options) list += (list.empty() ? "" : " or ") + o.first;
+    fail(path, "expected " + list + ", got " + describe(v), &v);
+  }
+
+  void positive(double x, const std::string& path, const YAML::Node& at, const char* what) const {
+    if (!(x > 0.0))
+      fail(path, std::string("must be > 0 (") + what + "), got " + format_double(x), &at);
+  }
+
+  Manifest load();
+
+ private:
+  ModuleSpec module(const YAML::Node& n, const std::string& path) const;
+  void noise(const YAML::Node& n, const std::string& path, ImuNoise& out) const;
+
+  fs::path file_;
+  const WarningSink& warn_;
+};
+
+Manifest Loader::load() {
+  std::error_code ec;
+  const auto st = fs::status(file_, ec);
+  if (ec || !fs::exists(st)) fail("", "manifest file not found");
+  if (fs::is_directory(st))
+    fail("", "is a directory, expected a manifest file (create one with `wheelins manifest DIR`)");
+  std::ifstream in(file_, std::ios::binary);
+  if (!in) fail("", std::string("cannot open: ") + std::strerror(errno));
+  std::stringstream buf;
+  buf << in.rdbuf();
+
+  YAML::Node root;
+  try {
+    root = YAML::Load(buf.str());
+  } catch (const YAML::Exception& e) {
+    std::string where;
+    if (!e.mark.is_null())
+      where = "line " + std::to_string(e.mark.line + 1) + ", column " +
+              std::to_string(e.mark.column + 1) + ": ";
+    fail("", where + "malformed YAML: " + e.msg);
+  }
+  if (!root.IsDefined() || root.IsNull()) fail("", "the manifest is empty");
+  require_map(root, "");
+  check_keys(root, "", kTopKeys);
+
+  Manifest m;
+  m.path = fs::absolute(file_).lexically_normal();
+
+  const YAML::Node fmt = required(root, "", "format");
+  if (text(fmt, "format") != kFormatId)
+    fail("format", std::string("unsupported manifest format ") + describe(fmt) +
+                       " (this build reads '" + kFormatId + "')",
+         &fmt);
+
+  if (auto v = get(root, "name"); v.IsDefined()) m.name = text(v, "name");
+  if (auto v = get(root, "truth"); v.IsDefined()) m.truth_file = fs::path(text(v, "truth"));
+  if (auto v = get(root, "odometer"); v.IsDefined()) m.odometer_file = fs::path(text(v, "odometer"));
+
+  if (auto v = get(root, "static_period_s"); v.IsDefined()) {
+    if (!v.IsSequence() || v.size() != 2)
+      fail("static_period_s", "expected a list of 2 times [start, end], got " +
+                                  (v.IsSequence() ? "a list of " + std::to_string(v.size())
+                                                  : describe(v)),
+           &v);
+    m.static_start = number(v[0], "static_period_s[0]");
+    m.static_end = number(v[1], "static_period_s[1]");
+    if (m.static_end < m.static_start)
+      fail("static_period_s", "end " + format_double(m.static_end) + " is before start " +
+                                  format_double(m.static_start),
+           &v);
+  }
+
+  {
+    const YAML::Node init = required(root, "", "initial");
+    require_map(init, "initial");
+    check_keys(init, "initial", kInitialKeys);
+    const YAML::Node lat = required(init, "initial", "lat_deg");
+    const YAML::Node lon = required(init, "initial", "lon_deg");
+    const YAML::Node h = required(init, "initial", "h_m");
+    const YAML::Node hd = required(init, "initial", "heading_deg");
+    const double lat_deg = number(lat, "initial.lat_deg");
+    const double lon_deg = number(lon, "initial.lon_deg");
+    if (std::abs(lat_deg) > 90.0)
+      fail("initial.lat_deg", "latitude must be within [-90, 90] deg, got " + format_double(lat_deg), &lat);
+    if (std::abs(lon_deg) > 360.0)
+      fail("initial.lon_deg", "longitude must be within [-360, 360] deg, got " + format_double(lon_deg), &lon);
+    m.origin.lat = number(lat, "initial.lat_deg", kDegU);
+    m.origin.lon = number(lon, "initial.lon_deg", kDegU);
+    m.origin.h = number(h, "initial.h_m");
+    m.initial_heading = number(hd, "initial.heading_deg", kDegU);
+  }
+
+  if (auto v = get(root, "gravity_m_s2"); v.IsDefined()) {
+    const double g = number(v, "gravity_m_s2");
+    positive(g, "gravity_m_s2", v, "gravity magnitude");
+    m.gravity = g;
+  }
+  if (auto v = get(root, "earth_rotation"); v.IsDefined()) m.earth_rotation = boolean(v, "earth_rotation");
+  if (auto veh = get(root, "vehicle"); veh.IsDefined()) {
+    require_map(veh, "vehicle");
+    check_keys(veh, "vehicle", kVehicleKeys);
+    if (auto v = get(veh, "track_m"); v.IsDefined()) {
+      m.track_width = number(v, "vehicle.track_m");
+      if (m.track_width < 0.0)
+        fail("vehicle.track_m", "must be >= 0 (0: unknown), got " + format_double(m.track_width), &v);
+    }
+  }
+
+  const YAML::Node mods = required(root, "", "modules");
+  if (!mods.IsSequence())
+    fail("modules", "expected a list of modules ('- name: ...' entries), got " + describe(mods), &mods);
+  if (mods.size() == 0) fail("modules", "no IMU module listed; a manifest needs at least one", &mods);
+  for (std::size_t i = 0; i < mods.size(); ++i) {
+    const std::string path = index_path("modules", i);
+    const YAML::Node entry = mods[i];
+    m.modules.push_back(module(entry, path));
+    for (std::size_t j = 0; j < i; ++j)
+      if (m.modules[j].name == m.modules[i].name)
+        fail(join(path, "name"), "duplicate module name '" + m.modules[i].name +
+                                     "' (also modules[" + std::to_string(j) + "])",
+             &entry);
+  }
+  return m;
+}
+
+ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
+  require_map(n, path);
+  check_keys(n, path, kModuleKeys);
+  ModuleSpec s;
+  s.name = text(required(n, path, "name"), join(path, "name"));
+  s.kind = choice<ModuleKind>(required(n, path, "kind"), join(path, "kind"),
+                              {{"wheel", ModuleKind::kWheel}, {"body", ModuleKind::kBody}});
+  s.group = s.name;
+  if (auto v = get(n, "group"); v.IsDefined()) s.group = text(v, join(path, "group"));
+  if (auto v = get(n, "chip"); v.IsDefined()) s.chip = text(v, join(path, "chip"));
+  s.file = fs::path(text(required(n, path, "file"), join(path, "file")));
+  if (auto v = get(n, "format"); v.IsDefined())
+    s.format = choice<SampleFormat>(v, join(path, "format"),
+                                    {{"rate", SampleFormat::kRate},
+                                     {"increment", SampleFormat::kIncrement}});
+  if (auto v = get(n, "layout"); v.IsDefined())
+    s.layout = choice<FileLayout>(v, join(path, "layout"),
+                                  {{"binary", FileLayout::kBinary}, {"text", FileLayout::kText}});
+  if (auto v = get(n, "rate_hz"); v.IsDefined()) {
+    s.rate_hz = number(v, join(path, "rate_hz"));
+    positive(s.rate_hz, join(path, "rate_hz"), v, "a sample rate");
+  }
+  if (auto v = get(n, "time_offset_s"); v.IsDefined()) s.time_offset = number(v, join(path, "time_offset_s"));
+  if (auto v = get(n, "position_v_m"); v.IsDefined()) s.p_inV = vec3(v, join(path, "position_v_m"));
+  if (auto v = get(n, "lever_arm_b_m"); v.IsDefined())
+    s.lever_arm_inB = vec3(v, join(path, "lever_arm_b_m"));
+  if (auto v = get(n, "mounting_deg"); v.IsDefined()) {
+    const std::string p = join(path, "mounting_deg");
+    const Vec3 deg = vec3(v, p);
+    if (std::abs(deg.y()) > 90.0)
+      fail(index_path(p, 1), "pitch must be within [-90, 90] deg, got " + format_double(deg.y()), &v);
+    for (int i : {0, 2})
+      if (std::abs(deg[i]) > 360.0)
+        fail(index_path(p, static_cast<std::size_t>(i)),
+             "angle must be within [-360, 360] deg, got " + format_double(deg[i]), &v);
+    s.mounting_rpy = vec3(v, p, kDegU);
+  }
+  if (auto v = get(n, "axle_sign"); v.IsDefined()) {
+    const double a = number(v, join(path, "axle_sign"));
+    if (a != 1.0 && a != -1.0)
+      fail(join(path, "axle_sign"),
+           "must be +1 (b x-axis points right) or -1 (points left), got " + describe(v), &v);
+    s.axle_sign = static_cast<int>(a);
+  }
+  if (auto v = get(n, "wheel_radius_m"); v.IsDefined()) {
+    s.wheel_radius = number(v, join(path, "wheel_radius_m"));
+    if (s.kind == ModuleKind::kWheel)
+      positive(s.wheel_radius, join(path, "wheel_radius_m"), v, "a wheel radius");
+    else if (s.wheel_radius < 0.0)
+      fail(join(path, "wheel_radius_m"), "must be >= 0, got " + format_double(s.wheel_radius), &v);
+  } else if (s.kind == ModuleKind::kWheel) {
+    fail(path, "missing required key 'wheel_radius_m' (every wheel module needs its wheel radius)", &n);
+  }
+  if (auto v = get(n, "noise"); v.IsDefined()) noise(v, join(path, "noise"), s.noise);
+  return s;
+}
+
+void Loader::noise(const YAML::Node& n, const std::string& path, ImuNoise& out) const {
+  require_map(n, path);
+  check_keys(n, path, noise_key_names());
+  for (const auto& k : kNoiseKeys) {
+    if (auto v = get(n, k.key); v.IsDefined()) {
+      const std::string p = join(path, k.key);
+      const double x = number(v, p);
+      positive(x, p, v, "noise figures and correlation times");
+      out.*k.member = number(v, p, k.unit);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------- writing
+
+std::string yaml_string(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\x%02x", c);
+          out += buf;
+        } else {
+          out += static_cast<char>(c);
+        }
+    }
+  }
+  return out + "\"";
+}
+
+class YamlWriter {
+ public:
+  explicit YamlWriter(const ManifestAnnotations& notes) : notes_(notes) {}
+  /// One "key: value" line at `indent` spaces; `path` selects an annotation.
+  void line(int indent, const std::string& text, const std::string& path, const char* unit_note = nullptr) {
+    std::string l(static_cast<std::size_t>(indent), ' ');
+    l += text;
+    std::string comment;
+    if (auto it = notes_.comments.find(path); it != notes_.comments.end()) comment = it->second;
+    if (unit_note && comment.empty()) comment = unit_note;
+    if (!comment.empty()) {
+      if (l.size() < 40) l.resize(40, ' ');
+      else l += "  ";
+      l += "# " + comment;
+    }
+    out_ += l + "\n";
+  }
+  void raw(const std::string& text) { out_ += text + "\n"; }
+  std::string str() const { return out_; }
+
+ private:
+  const ManifestAnnotations& notes_;
+  std::string out_;
+};
+
+std::string num(double si, Unit u = kOne) { return si_to_human(si, u); }
+std::string vec(const Vec3& v, Unit u = kOne) {
+  return "[" + num(v.x(), u) + ", " + num(v.y(), u) + ", " + num(v.z(), u) + "]";
+}
+
+/// A data-file path as it must be written in a manifest placed in `dir`.
+fs::path rebase(const Manifest& m, const fs::path& p, const fs::path& dir) {
+  if (p.is_absolute() || m.path.empty()) return p;
+  const fs::path from = fs::absolute(m.path).parent_path().lexically_normal();
+  const fs::path to = fs::absolute(dir).lexically_normal();
+  if (from == to) return p;
+  const fs::path abs = (from / p).lexically_normal();
+  fs::path rel = abs.lexically_relative(to);
+  return rel.empty() ? abs : rel;
+}
+
+}  // namespace
+
+const char* to_string(ModuleKind k) { return k == ModuleKind::kWheel ? "wheel" : "body"; }
+const char* to_string(SampleFormat f) { return f == SampleFormat::kRate ? "rate" : "increment"; }
+const char* to_string(FileLayout l) { return l == FileLayout::kBinary ? "binary" : "text"; }
+
+fs::path Manifest::resolve(const fs::path& p) const {
+  if (p.is_absolute() || path.empty()) return p;
+  return path.parent_path() / p;
+}
+
+const ModuleSpec* Manifest::find(const std::string& module_name) const {
+  for (const auto& mod : modules)
+    if (mod.name == module_name) return &mod;
+  return nullptr;
+}
+
+double Manifest::gravity_or_default() const {
+  return gravity ? *gravity : earth::normal_gravity(origin.lat, origin.h);
+}
+
+Manifest load_manifest(const fs::path& file) { return load_manifest(file, stderr_sink()); }
+
+Manifest load_manifest(const fs::path& file, const WarningSink& warn) {
+  return Loader(file, warn).load();
+}
+
+std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const ManifestAnnotations& notes) {
+  YamlWriter w(notes);
+  w.raw("# wheelins dataset manifest: human units, see docs/manifest.md");
+  for (const auto& h : notes.header) w.raw(h.empty() ? "#" : "# " + h);
+  w.line(0, std::string("format: ") + kFormatId, "format");
+  if (!m.name.empty()) w.line(0, "name: " + yaml_string(m.name), "name");
+  if (m.truth_file) w.line(0, "truth: " + yaml_string(rebase(m, *m.truth_file, dir).string()), "truth");
+  if (m.odometer_file)
+    w.line(0, "odometer: " + yaml_string(rebase(m, *m.odometer_file, dir).string()), "odometer");
+  w.line(0, "static_period_s: [" + num(m.static_start) + ", " + num(m.static_end) + "]",
+         "static_period_s", "initial alignment, data time [s]");
+  w.line(0, "initial:", "initial", "the w-frame origin o and the vehicle heading at the start");
+  w.line(2, "lat_deg: " + num(m.origin.lat, kDegU), "initial.lat_deg");
+  w.line(2, "lon_deg: " + num(m.origin.lon, kDegU), "initial.lon_deg");
+  w.line(2, "h_m: " + num(m.origin.h), "initial.h_m", "ellipsoidal height");
+  w.line(2, "heading_deg: " + num(m.initial_heading, kDegU), "initial.heading_deg");
+  if (m.gravity) w.line(0, "gravity_m_s2: " + num(*m.gravity), "gravity_m_s2");
+  w.line(0, std::string("earth_rotation: ") + (m.earth_rotation ? "true" : "false"), "earth_rotation",
+         "the data contain the earth rotation rate");
+  w.line(0, "vehicle:", "vehicle");
+  w.line(2, "track_m: " + num(m.track_width), "vehicle.track_m", "0: unknown");
+  w.line(0, "modules:", "modules");
+  for (std::size_t i = 0; i < m.modules.size(); ++i) {
+    const ModuleSpec& s = m.modules[i];
+    const std::string p = index_path("modules", i) + ".";
+    const bool wheel = s.kind == ModuleKind::kWheel;
+    w.line(2, "- name: " + yaml_string(s.name), index_path("modules", i));
+    w.line(4, std::string("kind: ") + to_string(s.kind), p + "kind");
+    if (!s.group.empty()) w.line(4, "group: " + yaml_string(s.group), p + "group");
+    if (!s.chip.empty()) w.line(4, "chip: " + yaml_string(s.chip), p + "chip");
+    w.line(4, "file: " + yaml_string(rebase(m, s.file, dir).string()), p + "file");
+    w.line(4, std::string("format: ") + to_string(s.format), p + "format",
+           "rate: rad/s, m/s^2; increment: rad, m/s per sample");
+    w.line(4, std::string("layout: ") + to_string(s.layout), p + "layout");
+    w.line(4, "rate_hz: " + num(s.rate_hz), p + "rate_hz");
+    w.line(4, "time_offset_s: " + num(s.time_offset), p + "time_offset_s", "added to the file's times");
+    w.line(4, "position_v_m: " + vec(s.p_inV), p + "position_v_m",
+           wheel ? "wheel centre in the v-frame" : "IMU centre in the v-frame");
+    if (wheel || s.lever_arm_inB != Vec3::Zero())
+      w.line(4, "lever_arm_b_m: " + vec(s.lever_arm_inB), p + "lever_arm_b_m",
+             "IMU centre -> wheel centre, b-frame");
+    w.line(4, "mounting_deg: " + vec(s.mounting_rpy, kDegU), p + "mounting_deg",
+           wheel ? "[roll, pitch, yaw] sensor axes vs ideal wheel frame" : "[roll, pitch, yaw] C_b^v");
+    if (wheel || s.axle_sign != 1)
+      w.line(4, "axle_sign: " + std::to_string(s.axle_sign), p + "axle_sign",
+             "+1: b x-axis points right, -1: left");
+    if (wheel || s.wheel_radius != 0.0)
+      w.line(4, "wheel_radius_m: " + num(s.wheel_radius), p + "wheel_radius_m");
+    w.line(4, "noise:", p + "noise");
+    for (const auto& k : kNoiseKeys)
+      w.line(6, std::string(k.key) + ": " + num(s.noise.*k.member, k.unit), p + "noise." + k.key);
+  }
+  return w.str();
+}
+
+void save_manifest(const Manifest& m, const fs::path& file) { save_manifest(m, file, {}); }
+
+void save_manifest(const Manifest& m, const fs::path& file, const ManifestAnnotations& notes) {
+  if (m.modules.empty()) throw InputError(quote(file) + ": refusing to write a manifest without modules");
+  std::error_code ec;
+  if (fs::is_directory(file, ec))
+    throw InputError(quote(file) + ": is a directory, expected a manifest file name");
+  const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  const std::string text = manifest_to_yaml(m, dir, notes);
+  if (file.has_parent_path()) {
+    fs::create_directories(file.parent_path(), ec);
+    if (ec) throw InputError(quote(file.parent_path()) + ": cannot create directory: " + ec.message());
+  }
+  const fs::path tmp = file.string() + ".partial";
+  {
+    std::FILE* fp = std::fopen(tmp.c_str(), "wb");
+    if (!fp) throw InputError(quote(tmp) + ": cannot create: " + std::strerror(errno));
+    const bool ok = std::fwrite(text.data(), 1, text.size(), fp) == text.size();
+    const int err = errno;
+    if (std::fclose(fp) != 0 || !ok) {
+      fs::remove(tmp, ec);
+      throw InputError(quote(tmp) + ": write failed: " + std::strerror(err));
+    }
+  }
+  fs::rename(tmp, file, ec);
+  if (ec) {
+    std::error_code ec2;
+    fs::remove(tmp, ec2);
+    throw InputError(quote(file) + ": cannot move the finished file into place: " + ec.message());
+  }
+}
+
+}  // namespace wheelins

@@ -1,0 +1,79 @@
+#include "wheelins/io/text_util.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <limits>
+#include <iostream>
+#include <vector>
+
+#include "wheelins/io/diagnostics.hpp"
+
+namespace wheelins {
+
+WarningSink stderr_sink() {
+  return [](const std::string& message) { std::cerr << "warning: " << message << "\n"; };
+}
+
+namespace io_detail {
+
+std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+std::string format_double(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+std::string format_long_double(long double v) {
+  char buf[128];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+namespace {
+template <class T>
+std::optional<T> parse_number(std::string_view s) {
+  const auto is_blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty() || s.front() == '+') return std::nullopt;
+  T v = 0;
+  const auto res = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (res.ec == std::errc::result_out_of_range) return std::nullopt;
+  if (res.ec != std::errc() || res.ptr != s.data() + s.size()) {
+    // YAML spells the special values .inf / -.inf / .nan.
+    std::string low(s);
+    std::transform(low.begin(), low.end(), low.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (low == ".nan") return std::numeric_limits<T>::quiet_NaN();
+    if (low == ".inf") return std::numeric_limits<T>::infinity();
+    if (low == "-.inf") return -std::numeric_limits<T>::infinity();
+    return std::nullopt;
+  }
+  return v;
+}
+}  // namespace
+
+std::optional<double> parse_double(std::string_view s) { return parse_number<double>(s); }
+std::optional<long double> parse_long_double(std::string_view s) {
+  return parse_number<long double>(s);
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t sub = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, sub});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+}  // namespace io_detail
+}  // namespace wheelins
