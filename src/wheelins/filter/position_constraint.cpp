@@ -15,10 +15,7 @@ ReferencePointModel reference_point_model(const ReferencePointInput& in) {
     const Vec3 Cl = C * in.lever_arm_inB;
     m.r_o = in.p_IinW + Cl - Rz * a;
     // (I - [phi x]) C l = C l + [(C l) x] phi; the heading enters through psi(C_b^w).
-    const Vec3 c1 = C.col(0);
-    const double h2 = c1.x() * c1.x() + c1.y() * c1.y();
-    const Eigen::RowVector3d dpsi_dphi =
-        Eigen::RowVector3d(-c1.y() / h2, c1.x() / h2, 0.0) * skew(c1);
+    const Eigen::RowVector3d dpsi_dphi = wheel_heading_sensitivity(C);
     const Vec3 dRa_dpsi = Rz * skew(Vec3::UnitZ()) * a;
     m.H.block<3, 3>(0, PHI) = skew(Cl) - dRa_dpsi * dpsi_dphi;
   } else {

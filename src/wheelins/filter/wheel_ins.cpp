@@ -7,9 +7,8 @@ namespace wheelins {
 
 WheelIns::WheelIns(const ModuleSpec& module, const WheelInsOptions& opt,
                    const MechanizationOptions& mech)
-    : module_(module),
+    : Subsystem(module, mech),
       opt_(opt),
-      mech_(mech),
       C_StoB_(dcm_from_euler(module.mounting_rpy)),
       axle_sign_(module.axle_sign) {
   window_len_ = std::clamp(static_cast<int>(std::lround(opt.speed_window * module.rate_hz)), 1,
@@ -37,7 +36,6 @@ void WheelIns::start(const StaticAccumulator& stat, double vehicle_heading, doub
   ImuErrors e;
   e.bg = stat.mean_omega() - C.transpose() * mech_.omega_ie_inW;
   ekf_.initialize(s, e, ProcessNoise::from(module_.noise), opt_.init, mech_);
-  next_update_t_ = t0 + opt_.velocity_update_interval;
   window_count_ = window_pos_ = 0;
   window_sum_ = 0.0;
 }
@@ -76,8 +74,6 @@ UpdateReport WheelIns::velocity_update(WheelVelocityInput in) {
   const WheelVelocityModel m = wheel_velocity_model(in);
   const Mat3 R = opt_.velocity_std.cwiseAbs2().asDiagonal();
   last_report_ = ekf_.update<3>(m.H, m.innovation(), R, opt_.gate);
-  // Re-schedule on the nominal grid (robust to a late epoch).
-  while (next_update_t_ <= ekf_.state().t + 1e-9) next_update_t_ += opt_.velocity_update_interval;
   return last_report_;
 }
 
@@ -90,7 +86,22 @@ Vec3 WheelIns::wheel_centre_inW() const {
   return s.p_IinW + s.C_ItoW() * module_.lever_arm_inB;
 }
 
-Vec3 WheelIns::reference_point_inW() const { return wheel_centre_inW() - C_VtoW() * module_.p_inV; }
+ReferencePointInput WheelIns::reference_point_input() const {
+  ReferencePointInput in;
+  in.wheel = true;
+  in.C_BtoW = ekf_.state().C_ItoW();
+  in.p_IinW = ekf_.state().p_IinW;
+  in.lever_arm_inB = module_.lever_arm_inB;
+  in.p_inV = module_.p_inV;
+  in.axle_sign = axle_sign_;
+  in.vehicle_roll = vehicle_roll_;
+  in.vehicle_pitch = vehicle_pitch_;
+  return in;
+}
+
+Eigen::RowVector3d WheelIns::heading_sensitivity() const {
+  return wheel_heading_sensitivity(ekf_.state().C_ItoW());
+}
 
 Vec3 WheelIns::reference_velocity_inW() const {
   const NavState& s = ekf_.state();

@@ -6,39 +6,35 @@
 
 #include <array>
 
-#include "wheelins/filter/alignment.hpp"
-#include "wheelins/filter/strapdown_ekf.hpp"
+#include "wheelins/filter/subsystem.hpp"
 #include "wheelins/filter/wheel_velocity.hpp"
-#include "wheelins/io/manifest.hpp"
 
 namespace wheelins {
 
 struct WheelInsOptions {
-  double velocity_update_interval = 0.5;       ///< [s]; the paper's 2 Hz
+  double velocity_update_interval = 0.5;       ///< [s]; the paper's 2 Hz (scheduled by the navigator)
   double speed_window = 0.05;                  ///< gyro-x averaging window for the speed [s]
   Vec3 velocity_std = Vec3(0.03, 0.02, 0.02);  ///< forward, lateral, vertical [m/s] (Table 9)
   double gate = 0.0;                           ///< innovation gate on the test ratio; 0 = off
   InitialUncertainty init;
 };
 
-class WheelIns {
+class WheelIns final : public Subsystem {
  public:
   static constexpr int kMaxWindow = 256;
 
   WheelIns(const ModuleSpec& module, const WheelInsOptions& opt, const MechanizationOptions& mech);
 
   /// Rotates a raw sample from the sensor axes into the ideal wheel b-frame (mounting angles).
-  ImuSample to_body(const ImuSample& sensor) const;
+  ImuSample to_body(const ImuSample& sensor) const override;
 
   /// Aligns from the static mean (b-frame samples) and starts navigating at time t0 with
   /// the reference point o at the w-frame origin and the given vehicle heading.
-  void start(const StaticAccumulator& stat, double vehicle_heading, double t0);
+  void start(const StaticAccumulator& stat, double vehicle_heading, double t0) override;
 
   /// One IMU epoch (b-frame sample, see to_body).
-  void propagate(const ImuSample& body_sample);
+  void propagate(const ImuSample& body_sample) override;
 
-  /// True when the velocity update scheduled at the update rate is due at the current epoch.
-  bool velocity_update_due() const { return ekf_.state().t + 1e-9 >= next_update_t_; }
   /// This wheel's forward speed from the mean compensated gyro x over the window [m/s].
   double wheel_speed() const;
   double mean_omega_x() const;
@@ -53,28 +49,24 @@ class WheelIns {
     vehicle_roll_ = roll;
     vehicle_pitch_ = pitch;
   }
-  double vehicle_heading() const { return wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_); }
+  double vehicle_heading() const override {
+    return wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_);
+  }
+  Eigen::RowVector3d heading_sensitivity() const override;
   Mat3 C_VtoW() const;
   /// Wheel-centre position in the w-frame.
   Vec3 wheel_centre_inW() const;
-  /// The reference point o (v-frame origin) in the w-frame, eq. (8): r_o = r_wc - C_v^w r_wc^v.
-  Vec3 reference_point_inW() const;
+  /// Eq. (8) through the wheel centre: r_o = r_b + C_b^w l^b - C_v^w r_wc^v.
+  ReferencePointInput reference_point_input() const override;
   /// Velocity of o from the wheel-centre velocity and the vehicle yaw rate.
-  Vec3 reference_velocity_inW() const;
+  Vec3 reference_velocity_inW() const override;
 
-  StrapdownEkf& ekf() { return ekf_; }
-  const StrapdownEkf& ekf() const { return ekf_; }
-  const ModuleSpec& module() const { return module_; }
   const UpdateReport& last_report() const { return last_report_; }
 
  private:
-  ModuleSpec module_;
   WheelInsOptions opt_;
-  MechanizationOptions mech_;
   Mat3 C_StoB_;
   int axle_sign_;
-  StrapdownEkf ekf_;
-  double next_update_t_ = 0.0;
   double vehicle_roll_ = 0.0, vehicle_pitch_ = 0.0;
   std::array<double, kMaxWindow> window_{};
   int window_len_ = 1, window_count_ = 0, window_pos_ = 0;

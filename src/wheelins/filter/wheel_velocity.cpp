@@ -14,6 +14,12 @@ void set_own_wheel_speed(WheelVelocityInput& in, double radius, double mean_omeg
   in.dspeed_dsgx = -in.axle_sign * radius * mean_omega_x;
 }
 
+Eigen::RowVector3d wheel_heading_sensitivity(const Mat3& C) {
+  const Vec3 c1 = C.col(0);
+  const double h2 = c1.x() * c1.x() + c1.y() * c1.y();
+  return Eigen::RowVector3d(-c1.y() / h2, c1.x() / h2, 0.0) * skew(c1);
+}
+
 WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   const Mat3& C = in.C_BtoW;
   const Vec3& l = in.lever_arm_inB;
@@ -36,10 +42,7 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
 
   // d z_hat / d phi: through C_b^w in the lever-arm term and the earth-rate term,
   // and through the heading psi_v = yaw(C_b^w) - axle_sign*pi/2 (the A and B blocks of App. B).
-  const Vec3 c1 = C.col(0);
-  const double h2 = c1.x() * c1.x() + c1.y() * c1.y();
-  const Eigen::RowVector3d dpsi_dc1(-c1.y() / h2, c1.x() / h2, 0.0);
-  const Eigen::RowVector3d dpsi_dphi = dpsi_dc1 * skew(c1);
+  const Eigen::RowVector3d dpsi_dphi = wheel_heading_sensitivity(C);
   const Vec3 dz_dpsi = -(Ryx.transpose() * skew(Vec3::UnitZ()) * Rz.transpose()) * u;
   m.H.block<3, 3>(0, PHI) = C_WtoV * (skew(rot_vel_inW) - C * skew(l) * C.transpose() *
                                                                skew(in.omega_ie_inW)) +

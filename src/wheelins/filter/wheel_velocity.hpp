@@ -45,6 +45,9 @@ struct WheelVelocityModel {
 
 /// Vehicle heading implied by a Wheel-IMU attitude: yaw of the b x-axis - axle_sign * 90 deg.
 double wheel_vehicle_heading(const Mat3& C_BtoW, int axle_sign);
+/// d(psi_v)/d(phi): psi = atan2(c1_y, c1_x) of the b x-axis c1, and C_hat = (I - [phi x]) C
+/// moves c1 by [c1 x] phi. Exact to first order for any Wheel-IMU attitude.
+Eigen::RowVector3d wheel_heading_sensitivity(const Mat3& C_BtoW);
 
 WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in);
 

@@ -1,26 +1,34 @@
 #include "wheelins/fusion/navigator.hpp"
 
 #include <cmath>
+#include <numeric>
 #include <sstream>
 
 namespace wheelins {
 
 std::string NavigatorOptions::describe() const {
   std::ostringstream o;
-  o << "velocity update interval: " << wheel.velocity_update_interval << " s\n"
-    << "wheel speed window:       " << wheel.speed_window << " s\n"
-    << "velocity noise (fwd/lat/vert): " << wheel.velocity_std.transpose() << " m/s\n"
-    << "innovation gate:          "
-    << (wheel.gate > 0 ? std::to_string(wheel.gate) : std::string("off")) << "\n"
-    << "initial sigma: position " << wheel.init.position << " m, velocity "
+  auto onoff = [](bool b) { return b ? "on" : "off"; };
+  o << "velocity update interval:   " << wheel.velocity_update_interval << " s\n"
+    << "wheel speed window:         " << wheel.speed_window << " s\n"
+    << "wheel speed sharing:        "
+    << (fusion.speed == SpeedSharing::kMean ? "mean of Wheel-IMUs (paper)" : "own wheel") << "\n"
+    << "Wheel-INS velocity sigma:   " << wheel.velocity_std.transpose() << " m/s\n"
+    << "Body-INS velocity sigma:    " << body.velocity_std.transpose() << " m/s\n"
+    << "position constraint:        " << onoff(fusion.position_constraint) << ", every "
+    << fusion.position_update_interval << " s, sigma " << fusion.position_std << " m\n"
+    << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
+    << "innovation gates (vel/pos): " << wheel.gate << " / " << fusion.position_gate
+    << " (0 = off)\n"
+    << "initial sigma:              position " << wheel.init.position << " m, velocity "
     << wheel.init.velocity << " m/s, roll/pitch " << wheel.init.roll_pitch / kDeg
     << " deg, heading " << wheel.init.heading / kDeg << " deg\n"
-    << "mechanization:            "
+    << "mechanization:              "
     << (mechanization == MechanizationOptions::Method::kRotationExact ? "rotation-exact"
                                                                        : "classic two-sample")
     << "\n"
-    << "earth rotation:           " << (earth_rotation ? "compensated" : "ignored") << "\n"
-    << "output interval:          "
+    << "earth rotation:             " << (earth_rotation ? "compensated" : "ignored") << "\n"
+    << "output interval:            "
     << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
     << "\n";
   return o.str();
@@ -42,41 +50,76 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
       throw InputError("'" + manifest_.path.string() + "': no module named '" + name +
                        "' (modules: " + known + ")");
     }
-    if (m->kind != ModuleKind::kWheel)
-      throw InputError("module '" + name +
-                       "' is a Body-IMU: this build's navigator runs Wheel-IMUs only "
-                       "(Body-INS arrives with the multi-IMU fusion)");
-    wheels_.push_back(std::make_unique<WheelIns>(*m, opt_.wheel, mech));
+    if (m->kind == ModuleKind::kWheel) {
+      auto w = std::make_unique<WheelIns>(*m, opt_.wheel, mech);
+      wheels_.push_back(w.get());
+      subs_.push_back(std::move(w));
+    } else {
+      if (body_)
+        throw InputError("module '" + name + "': only one Body-IMU can share its attitude; '" +
+                         body_->module().name + "' is already selected");
+      auto b = std::make_unique<BodyIns>(*m, opt_.body, mech);
+      body_ = b.get();
+      subs_.push_back(std::move(b));
+    }
   }
-  static_.resize(wheels_.size());
+  if (wheels_.empty())
+    throw InputError("no Wheel-IMU among the selected modules: at least one IMU must be on a "
+                     "wheel to measure the wheel speed");
+  weights_ = opt_.fusion.weights;
+  if (weights_.empty()) weights_.assign(subs_.size(), 1.0);
+  if (weights_.size() != subs_.size())
+    throw InputError("fusion weights: " + std::to_string(weights_.size()) + " given for " +
+                     std::to_string(subs_.size()) + " modules");
+  const double wsum = std::accumulate(weights_.begin(), weights_.end(), 0.0);
+  for (double w : weights_)
+    if (!(w >= 0.0) || !(wsum > 0.0))
+      throw InputError("fusion weights must be >= 0 with a positive sum");
+  for (double& w : weights_) w /= wsum;
+  static_.resize(subs_.size());
 }
 
 Navigator::~Navigator() = default;
 
+double Navigator::min_time() const {
+  double t = subs_[0]->time();
+  for (const auto& s : subs_) t = std::min(t, s->time());
+  return t;
+}
+
 void Navigator::process(int index, const ImuSample& raw) {
   ++stats_.samples;
-  WheelIns& w = *wheels_[index];
-  const ImuSample b = w.to_body(raw);
+  Subsystem& s = *subs_[index];
+  const ImuSample b = s.to_body(raw);
   if (!navigating_) {
     if (raw.t <= manifest_.static_start) return;
     if (raw.t <= manifest_.static_end + 1e-9) {
       static_[index].add(b);
       return;
     }
-    start_navigation(raw.t - raw.dt);
+    start_navigation(manifest_.static_end);
   }
-  w.propagate(b);
+  s.propagate(b);
+
+  // Updates when every subsystem has reached the scheduled time.
+  const double t_all = min_time();
+  if (t_all + 1e-9 >= next_velocity_t_) {
+    velocity_updates();
+    while (next_velocity_t_ <= t_all + 1e-9) next_velocity_t_ += opt_.wheel.velocity_update_interval;
+  }
+  if (subs_.size() > 1 && opt_.fusion.position_constraint && t_all + 1e-9 >= next_position_t_) {
+    position_update();
+    while (next_position_t_ <= t_all + 1e-9)
+      next_position_t_ += opt_.fusion.position_update_interval;
+  }
+
   if (index != 0) return;
   ++stats_.epochs;
-  if (w.velocity_update_due()) {
-    const UpdateReport rep = w.velocity_update(w.own_velocity_input());
-    ++stats_.velocity_updates;
-    if (!rep.accepted) ++stats_.velocity_rejected;
-    stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
-  }
   stats_.t_end = raw.t;
   if (raw.t + 1e-9 >= next_output_t_) {
-    sink_(make_record());
+    sink_(0, vehicle_record());
+    if (subs_.size() > 1)
+      for (int i = 0; i < subsystem_count(); ++i) sink_(i + 1, subsystem_record(i));
     ++stats_.records;
     if (opt_.output_interval > 0)
       while (next_output_t_ <= raw.t + 1e-9) next_output_t_ += opt_.output_interval;
@@ -84,38 +127,100 @@ void Navigator::process(int index, const ImuSample& raw) {
 }
 
 void Navigator::start_navigation(double t0) {
-  for (std::size_t i = 0; i < wheels_.size(); ++i) {
+  for (std::size_t i = 0; i < subs_.size(); ++i) {
     if (static_[i].count() < 10)
-      throw InputError("module '" + wheels_[i]->module().name + "': only " +
-                       std::to_string(static_[i].count()) +
-                       " samples in the static period [" + std::to_string(manifest_.static_start) +
-                       ", " + std::to_string(manifest_.static_end) +
+      throw InputError("module '" + subs_[i]->module().name + "': only " +
+                       std::to_string(static_[i].count()) + " samples in the static period [" +
+                       std::to_string(manifest_.static_start) + ", " +
+                       std::to_string(manifest_.static_end) +
                        "] s: the alignment needs a static period covered by the data");
-    wheels_[i]->start(static_[i], manifest_.initial_heading, t0);
+    subs_[i]->start(static_[i], manifest_.initial_heading, t0);
   }
   navigating_ = true;
   stats_.t_start = t0;
   next_output_t_ = t0;
+  next_velocity_t_ = t0 + opt_.wheel.velocity_update_interval;
+  next_position_t_ = t0 + opt_.fusion.position_update_interval;
 }
 
-TrajectoryRecord Navigator::make_record() const {
-  const WheelIns& w = *wheels_[0];
-  const StrapdownEkf& ekf = w.ekf();
+void Navigator::velocity_updates() {
+  // Shared information (Section III): vehicle level from the Body-INS, wheel speed.
+  if (body_ && opt_.fusion.share_level) {
+    const Vec3 rpy = body_->vehicle_rpy();
+    for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
+  }
+  const double n = static_cast<double>(wheels_.size());
+  double mean_speed = 0.0;
+  Vec3 mean_point = Vec3::Zero();
+  for (WheelIns* w : wheels_) {
+    mean_speed += w->wheel_speed() / n;
+    mean_point += w->module().p_inV / n;
+  }
+  auto count = [&](const UpdateReport& rep) {
+    ++stats_.velocity_updates;
+    if (!rep.accepted) ++stats_.velocity_rejected;
+    stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
+  };
+  for (WheelIns* w : wheels_) {
+    WheelVelocityInput in = w->own_velocity_input();
+    if (opt_.fusion.speed == SpeedSharing::kMean && wheels_.size() > 1) {
+      // Its own speed enters the mean with weight 1/n.
+      in.measured_speed = mean_speed;
+      in.dspeed_dbgx /= n;
+      in.dspeed_dsgx /= n;
+    }
+    count(w->velocity_update(in));
+  }
+  if (body_) {
+    // The mean speed of the wheels is the speed of the mean of their centres (o for a
+    // symmetric pair; the wheel centre itself for one wheel).
+    count(body_->velocity_update(mean_speed, mean_point));
+  }
+}
+
+void Navigator::position_update() {
+  // Algorithm 1: o in every subsystem's frame, their weighted mean as the measurement.
+  std::vector<ReferencePointModel> models;
+  models.reserve(subs_.size());
+  Vec3 fused = Vec3::Zero();
+  for (std::size_t i = 0; i < subs_.size(); ++i) {
+    models.push_back(reference_point_model(subs_[i]->reference_point_input()));
+    fused += weights_[i] * models.back().r_o;
+  }
+  const double sd = opt_.fusion.position_std;
+  const Mat3 R = Mat3::Identity() * sd * sd;
+  for (std::size_t i = 0; i < subs_.size(); ++i) {
+    const Vec3 dz = models[i].r_o - fused;
+    const UpdateReport rep =
+        subs_[i]->ekf().update<3>(models[i].H, dz, R, opt_.fusion.position_gate);
+    ++stats_.position_updates;
+    if (!rep.accepted) ++stats_.position_rejected;
+    stats_.max_position_test_ratio = std::max(stats_.max_position_test_ratio, rep.test_ratio);
+  }
+}
+
+TrajectoryRecord Navigator::subsystem_record(int i) const {
+  const Subsystem& s = *subs_[i];
+  const StrapdownEkf& ekf = s.ekf();
   const Mat21& P = ekf.covariance();
   TrajectoryRecord r;
   r.t = ekf.state().t;
-  r.p_inN = w.reference_point_inW();
+  const ReferencePointModel m = reference_point_model(s.reference_point_input());
+  r.p_inN = m.r_o;
   r.lla = frame_.geodetic_from_ned(r.p_inN);
-  r.v_inN = w.reference_velocity_inW();
-  r.rpy = Vec3(0.0, 0.0, w.vehicle_heading());
-  r.p_std = P.block<3, 3>(StateIndex::P, StateIndex::P).diagonal().cwiseSqrt();
-  r.v_std = P.block<3, 3>(V, V).diagonal().cwiseSqrt();
-  // Heading sigma through d(psi)/d(phi) of the Wheel-IMU x-axis (wheel_velocity.cpp).
-  const Vec3 c1 = ekf.state().C_ItoW().col(0);
-  const double h2 = c1.x() * c1.x() + c1.y() * c1.y();
-  const Eigen::RowVector3d J = Eigen::RowVector3d(-c1.y() / h2, c1.x() / h2, 0.0) * skew(c1);
+  r.v_inN = s.reference_velocity_inW();
+  const Eigen::RowVector3d J = s.heading_sensitivity();
   const double var_psi = J * P.block<3, 3>(PHI, PHI) * J.transpose();
-  r.rpy_std = Vec3(0.0, 0.0, std::sqrt(std::max(0.0, var_psi)));
+  if (!s.is_wheel()) {
+    r.rpy = static_cast<const BodyIns&>(s).vehicle_rpy();
+    r.rpy_std.head<2>() = P.block<2, 2>(PHI, PHI).diagonal().cwiseSqrt();
+  } else {
+    r.rpy = Vec3(0.0, 0.0, s.vehicle_heading());
+    if (body_ && opt_.fusion.share_level) r.rpy.head<2>() = body_->vehicle_rpy().head<2>();
+  }
+  r.rpy_std.z() = std::sqrt(std::max(0.0, var_psi));
+  r.p_std = (m.H * P * m.H.transpose()).diagonal().cwiseSqrt();
+  r.v_std = P.block<3, 3>(V, V).diagonal().cwiseSqrt();
   const ImuErrors& e = ekf.errors();
   r.bg = e.bg;
   r.ba = e.ba;
@@ -125,6 +230,39 @@ TrajectoryRecord Navigator::make_record() const {
   r.ba_std = P.block<3, 3>(BA, BA).diagonal().cwiseSqrt();
   r.sg_std = P.block<3, 3>(SG, SG).diagonal().cwiseSqrt();
   r.sa_std = P.block<3, 3>(SA, SA).diagonal().cwiseSqrt();
+  return r;
+}
+
+TrajectoryRecord Navigator::vehicle_record() const {
+  TrajectoryRecord r = subsystem_record(0);
+  if (subs_.size() == 1) return r;
+  // Output as in the paper: the fused reference point and the mean heading. The 1-sigma
+  // of a weighted mean is bounded by the weighted mean of the sigmas whatever the
+  // correlation between subsystems (Minkowski), which is what is reported.
+  Vec3 p = Vec3::Zero(), v = Vec3::Zero(), p_std = Vec3::Zero(), v_std = Vec3::Zero();
+  double s = 0.0, c = 0.0, psi_std = 0.0;
+  for (int i = 0; i < subsystem_count(); ++i) {
+    const TrajectoryRecord ri = subsystem_record(i);
+    const double k = weights_[i];
+    p += k * ri.p_inN;
+    v += k * ri.v_inN;
+    p_std += k * ri.p_std;
+    v_std += k * ri.v_std;
+    s += k * std::sin(ri.rpy.z());
+    c += k * std::cos(ri.rpy.z());
+    psi_std += k * ri.rpy_std.z();
+  }
+  r.p_inN = p;
+  r.lla = frame_.geodetic_from_ned(p);
+  r.v_inN = v;
+  r.p_std = p_std;
+  r.v_std = v_std;
+  r.rpy.z() = std::atan2(s, c);
+  r.rpy_std.z() = psi_std;
+  if (body_) {
+    const Vec3 rpy = body_->vehicle_rpy();
+    r.rpy.head<2>() = rpy.head<2>();
+  }
   return r;
 }
 

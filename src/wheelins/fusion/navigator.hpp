@@ -1,8 +1,15 @@
 // The navigator: turns a time-ordered stream of IMU samples from the modules of
 // a manifest into a vehicle trajectory. Data flow (one way):
-//   samples -> static alignment -> subsystems (Wheel-INS, ...) -> fusion -> records.
+//   samples -> static alignment -> subsystems (Wheel-INS, Body-INS) -> fusion -> records.
 // Phases: samples before the static period are skipped, samples inside it are
 // accumulated for the initial alignment, navigation starts at its end.
+//
+// Fusion (paper Section III and V-B, the distributed filter): every subsystem keeps
+// its own 21-state EKF. At the velocity-update rate the wheel speed is shared (the
+// mean over the Wheel-INSs, or each wheel's own speed), the Body-INS's roll/pitch is
+// given to the Wheel-INSs, and every subsystem fuses its velocity + NHC. At the
+// position-constraint rate, the weighted mean of the subsystems' reference points
+// (eq. 9) is a position measurement for each of them (eq. 12).
 #pragma once
 
 #include <functional>
@@ -10,36 +17,60 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/filter/body_ins.hpp"
 #include "wheelins/filter/wheel_ins.hpp"
 #include "wheelins/io/trajectory.hpp"
 
 namespace wheelins {
 
+/// How the Wheel-INSs get their forward speed.
+enum class SpeedSharing {
+  kMean,  ///< the paper: the mean of all Wheel-IMU speeds, for every subsystem
+  kOwn,   ///< each Wheel-INS its own wheel's speed; a Body-INS the mean, at the mean wheel point
+};
+
+struct FusionOptions {
+  SpeedSharing speed = SpeedSharing::kMean;
+  bool share_level = true;                ///< Body-INS roll/pitch to the Wheel-INSs
+  bool position_constraint = true;
+  double position_update_interval = 1.0;  ///< [s]; the paper's 1 Hz
+  double position_std = 0.2;              ///< [m] (Table 9)
+  double position_gate = 0.0;             ///< test-ratio gate; 0 = off
+  std::vector<double> weights;            ///< k_i of eq. (9); empty = equal
+};
+
 struct NavigatorOptions {
   WheelInsOptions wheel;
+  BodyInsOptions body;
+  FusionOptions fusion;
   MechanizationOptions::Method mechanization = MechanizationOptions::Method::kRotationExact;
   /// Compensate the earth rotation (the manifest says whether the data contain it).
   bool earth_rotation = true;
   /// Output interval [s]; 0 = every epoch of the first module.
   double output_interval = 0.0;
-  /// Print the options in human units (OpenVINS style), one per line.
+  /// The options in human units (OpenVINS style), one per line.
   std::string describe() const;
 };
 
 /// Counters and timing of a run.
 struct NavigatorStats {
   std::uint64_t samples = 0;            ///< samples given to process()
-  std::uint64_t epochs = 0;             ///< navigation epochs (after alignment)
-  std::uint64_t velocity_updates = 0;
+  std::uint64_t epochs = 0;             ///< navigation epochs of the first module
+  std::uint64_t velocity_updates = 0;   ///< per subsystem, summed
   std::uint64_t velocity_rejected = 0;  ///< refused by the innovation gate
+  std::uint64_t position_updates = 0;
+  std::uint64_t position_rejected = 0;
   std::uint64_t records = 0;
   double t_start = 0.0, t_end = 0.0;    ///< navigation interval [s]
   double max_velocity_test_ratio = 0.0;
+  double max_position_test_ratio = 0.0;
 };
 
 class Navigator {
  public:
-  using Sink = std::function<void(const TrajectoryRecord&)>;
+  /// Receives records: stream 0 is the vehicle (the fused solution), streams 1..N the
+  /// subsystems' own solutions (only when N > 1).
+  using Sink = std::function<void(int stream, const TrajectoryRecord&)>;
 
   /// `modules`: names from the manifest; the first one drives the output epochs.
   /// Throws InputError if a name is unknown or the set has no Wheel-IMU.
@@ -53,21 +84,29 @@ class Navigator {
 
   bool navigating() const { return navigating_; }
   const NavigatorStats& stats() const { return stats_; }
-  const WheelIns& wheel(int i) const { return *wheels_.at(i); }
-  int module_count() const { return static_cast<int>(wheels_.size()); }
+  int subsystem_count() const { return static_cast<int>(subs_.size()); }
+  const Subsystem& subsystem(int i) const { return *subs_.at(i); }
+  /// The fused vehicle solution now.
+  TrajectoryRecord vehicle_record() const;
 
  private:
   void start_navigation(double t0);
-  TrajectoryRecord make_record() const;
+  void velocity_updates();
+  void position_update();
+  TrajectoryRecord subsystem_record(int i) const;
+  double min_time() const;
 
   Manifest manifest_;
   NavigatorOptions opt_;
   Sink sink_;
   earth::LocalFrame frame_;
-  std::vector<std::unique_ptr<WheelIns>> wheels_;
+  std::vector<std::unique_ptr<Subsystem>> subs_;
+  std::vector<WheelIns*> wheels_;
+  BodyIns* body_ = nullptr;
+  std::vector<double> weights_;
   std::vector<StaticAccumulator> static_;
   bool navigating_ = false;
-  double next_output_t_ = 0.0;
+  double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
   NavigatorStats stats_;
 };
 

@@ -1,0 +1,60 @@
+#include "wheelins/filter/body_ins.hpp"
+
+#include "wheelins/filter/wheel_velocity.hpp"
+
+namespace wheelins {
+
+BodyIns::BodyIns(const ModuleSpec& module, const BodyInsOptions& opt,
+                 const MechanizationOptions& mech)
+    : Subsystem(module, mech), opt_(opt), C_BtoV_(dcm_from_euler(module.mounting_rpy)) {}
+
+void BodyIns::start(const StaticAccumulator& stat, double vehicle_heading, double t0) {
+  NavState s;
+  s.t = t0;
+  const Mat3 C = align_attitude(stat.mean_f(), vehicle_heading, C_BtoV_);
+  s.q_ItoW = Quat(C).normalized();
+  s.p_IinW = C * C_BtoV_.transpose() * module_.p_inV;  // o at the origin
+  ImuErrors e;
+  e.bg = stat.mean_omega() - C.transpose() * mech_.omega_ie_inW;
+  ekf_.initialize(s, e, ProcessNoise::from(module_.noise), opt_.init, mech_);
+}
+
+Eigen::RowVector3d BodyIns::heading_sensitivity() const {
+  // The vehicle x-axis C_v^w e1 moves like any vector attached to the b-frame.
+  return wheel_heading_sensitivity(C_VtoW());
+}
+
+ReferencePointInput BodyIns::reference_point_input() const {
+  ReferencePointInput in;
+  in.wheel = false;
+  in.C_BtoW = ekf_.state().C_ItoW();
+  in.p_IinW = ekf_.state().p_IinW;
+  in.p_inV = module_.p_inV;
+  in.C_BtoV = C_BtoV_;
+  return in;
+}
+
+Vec3 BodyIns::reference_velocity_inW() const {
+  const NavState& s = ekf_.state();
+  const Mat3 C = s.C_ItoW();
+  const Vec3 omega_nb = ekf_.omega_ib_b() - C.transpose() * mech_.omega_ie_inW;
+  const Vec3 l_o = C_BtoV_.transpose() * (-module_.p_inV);
+  return s.v_IinW + C * omega_nb.cross(l_o);
+}
+
+UpdateReport BodyIns::velocity_update(double speed, const Vec3& point_inV) {
+  BodyVelocityInput in;
+  in.C_BtoW = ekf_.state().C_ItoW();
+  in.v_IinW = ekf_.state().v_IinW;
+  in.omega_ib_b = ekf_.omega_ib_b();
+  in.omega_ie_inW = mech_.omega_ie_inW;
+  in.C_BtoV = C_BtoV_;
+  in.lever_arm_inB = C_BtoV_.transpose() * (point_inV - module_.p_inV);
+  in.measured_speed = speed;
+  const BodyVelocityModel m = body_velocity_model(in);
+  const Mat3 R = opt_.velocity_std.cwiseAbs2().asDiagonal();
+  last_report_ = ekf_.update<3>(m.H, m.innovation(), R, opt_.gate);
+  return last_report_;
+}
+
+}  // namespace wheelins
