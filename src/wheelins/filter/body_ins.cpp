@@ -42,7 +42,7 @@ Vec3 BodyIns::reference_velocity_inW() const {
   return s.v_IinW + C * omega_nb.cross(l_o);
 }
 
-UpdateReport BodyIns::velocity_update(double speed, const Vec3& point_inV) {
+BodyVelocityModel BodyIns::velocity_model(double speed, const Vec3& point_inV) const {
   BodyVelocityInput in;
   in.C_BtoW = ekf_.state().C_ItoW();
   in.v_IinW = ekf_.state().v_IinW;
@@ -51,10 +51,7 @@ UpdateReport BodyIns::velocity_update(double speed, const Vec3& point_inV) {
   in.C_BtoV = C_BtoV_;
   in.lever_arm_inB = C_BtoV_.transpose() * (point_inV - module_.p_inV);
   in.measured_speed = speed;
-  const BodyVelocityModel m = body_velocity_model(in);
-  const Mat3 R = opt_.velocity_std.cwiseAbs2().asDiagonal();
-  last_report_ = ekf_.update<3>(m.H, m.innovation(), R, opt_.gate);
-  return last_report_;
+  return body_velocity_model(in);
 }
 
 }  // namespace wheelins

@@ -33,14 +33,15 @@ class BodyIns final : public Subsystem {
   ReferencePointInput reference_point_input() const override;
   Vec3 reference_velocity_inW() const override;
 
-  /// Velocity + NHC at the rear-axle point p_inV (a wheel centre, or o) moving at `speed`.
-  UpdateReport velocity_update(double speed, const Vec3& point_inV);
-  const UpdateReport& last_report() const { return last_report_; }
+  /// Velocity + NHC model (eq. 6) at the rear-axle point p_inV (a wheel centre, or o)
+  /// moving at `speed`.
+  BodyVelocityModel velocity_model(double speed, const Vec3& point_inV) const;
+  Mat3 velocity_noise() const { return opt_.velocity_std.cwiseAbs2().asDiagonal(); }
+  double velocity_gate() const { return opt_.gate; }
 
  private:
   BodyInsOptions opt_;
   Mat3 C_BtoV_;
-  UpdateReport last_report_;
 };
 
 }  // namespace wheelins

@@ -36,7 +36,8 @@ Mat21 error_dynamics(const Mat3& C, const Vec3& omega_b, const Vec3& f_b, const 
   return F;
 }
 
-void propagate_covariance(Mat21& P, const Mat21& F, const ProcessNoise& q, double dt) {
+namespace {
+Vec21 noise_density(const ProcessNoise& q) {
   Vec21 qc = Vec21::Zero();
   qc.segment<3>(V).setConstant(q.acc_vrw * q.acc_vrw);
   qc.segment<3>(PHI).setConstant(q.gyro_arw * q.gyro_arw);
@@ -45,13 +46,26 @@ void propagate_covariance(Mat21& P, const Mat21& F, const ProcessNoise& q, doubl
   qc.segment<3>(BA).setConstant(2.0 * q.acc_bias_std * q.acc_bias_std / q.acc_bias_tau);
   qc.segment<3>(SG).setConstant(2.0 * q.gyro_sf_std * q.gyro_sf_std / q.gyro_sf_tau);
   qc.segment<3>(SA).setConstant(2.0 * q.acc_sf_std * q.acc_sf_std / q.acc_sf_tau);
+  return qc;
+}
+}  // namespace
 
+Mat21 transition_matrix(const Mat21& F, double dt) {
   Mat21 Phi = F * dt;
   Phi.diagonal().array() += 1.0;
-  const Mat21 PhiQ = Phi * qc.asDiagonal();
-  P = Phi * P * Phi.transpose();
-  P.noalias() += 0.5 * dt * (PhiQ * Phi.transpose());
-  P.diagonal() += 0.5 * dt * qc;
+  return Phi;
+}
+
+Mat21 discrete_noise(const Mat21& Phi, const ProcessNoise& q, double dt) {
+  const Vec21 qc = noise_density(q);
+  Mat21 Qd = 0.5 * dt * (Phi * qc.asDiagonal() * Phi.transpose());
+  Qd.diagonal() += 0.5 * dt * qc;
+  return Qd;
+}
+
+void propagate_covariance(Mat21& P, const Mat21& F, const ProcessNoise& q, double dt) {
+  const Mat21 Phi = transition_matrix(F, dt);
+  P = Phi * P * Phi.transpose() + discrete_noise(Phi, q, dt);
   condition_covariance(P);
 }
 

@@ -25,6 +25,11 @@ struct ProcessNoise {
 Mat21 error_dynamics(const Mat3& C_BtoW, const Vec3& omega_b, const Vec3& f_b,
                      const Vec3& omega_ie_inW, const ProcessNoise& q);
 
+/// Phi = I + F dt.
+Mat21 transition_matrix(const Mat21& F, double dt);
+/// The trapezoidal Qd = (Phi Qc Phi^T + Qc) dt / 2.
+Mat21 discrete_noise(const Mat21& Phi, const ProcessNoise& q, double dt);
+
 /// P <- Phi P Phi^T + Qd over dt, with Phi = I + F dt and the trapezoidal
 /// Qd = (Phi Qc Phi^T + Qc) dt / 2, Qc the diagonal noise density (the noise
 /// enters through C, which is orthogonal, so C Qc C^T = Qc for isotropic sensors).

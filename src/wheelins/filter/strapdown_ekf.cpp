@@ -22,14 +22,13 @@ void StrapdownEkf::initialize(const NavState& state, const ImuErrors& errors,
   initialized_ = true;
 }
 
-void StrapdownEkf::propagate(const ImuSample& raw) {
+void StrapdownEkf::propagate_nominal(const ImuSample& raw) {
   const ImuSample cur = compensate(raw, errors_);
   mechanize(mech_, have_last_ ? last_ : cur, cur, state_);
   last_ = cur;
   have_last_ = true;
-  const Mat21 F = error_dynamics(state_.C_ItoW(), cur.dtheta / cur.dt, cur.dvel / cur.dt,
-                                 mech_.omega_ie_inW, noise_);
-  propagate_covariance(P_, F, noise_, cur.dt);
+  F_ = error_dynamics(state_.C_ItoW(), cur.dtheta / cur.dt, cur.dvel / cur.dt,
+                      mech_.omega_ie_inW, noise_);
 }
 
 void StrapdownEkf::feedback(const Vec21& dx) {

@@ -70,13 +70,6 @@ WheelVelocityInput WheelIns::own_velocity_input() const {
   return in;
 }
 
-UpdateReport WheelIns::velocity_update(WheelVelocityInput in) {
-  const WheelVelocityModel m = wheel_velocity_model(in);
-  const Mat3 R = opt_.velocity_std.cwiseAbs2().asDiagonal();
-  last_report_ = ekf_.update<3>(m.H, m.innovation(), R, opt_.gate);
-  return last_report_;
-}
-
 Mat3 WheelIns::C_VtoW() const {
   return rot_z(vehicle_heading()) * rot_y(vehicle_pitch_) * rot_x(vehicle_roll_);
 }

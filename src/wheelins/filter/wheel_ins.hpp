@@ -38,9 +38,11 @@ class WheelIns final : public Subsystem {
   /// This wheel's forward speed from the mean compensated gyro x over the window [m/s].
   double wheel_speed() const;
   double mean_omega_x() const;
-  /// Velocity + NHC update with the given measurement input (see own_velocity_input()).
-  UpdateReport velocity_update(WheelVelocityInput in);
-  /// The input for an update with this wheel's own speed and the current vehicle roll/pitch.
+  /// Its velocity measurement noise covariance (Table 9).
+  Mat3 velocity_noise() const { return opt_.velocity_std.cwiseAbs2().asDiagonal(); }
+  double velocity_gate() const { return opt_.gate; }
+  /// The velocity/NHC measurement input (wheel_velocity_model()) with this wheel's own
+  /// speed and the current vehicle roll/pitch.
   WheelVelocityInput own_velocity_input() const;
 
   /// Vehicle roll/pitch assumed in the velocity model (0: horizontal-plane assumption;
@@ -61,8 +63,6 @@ class WheelIns final : public Subsystem {
   /// Velocity of o from the wheel-centre velocity and the vehicle yaw rate.
   Vec3 reference_velocity_inW() const override;
 
-  const UpdateReport& last_report() const { return last_report_; }
-
  private:
   WheelInsOptions opt_;
   Mat3 C_StoB_;
@@ -71,7 +71,6 @@ class WheelIns final : public Subsystem {
   std::array<double, kMaxWindow> window_{};
   int window_len_ = 1, window_count_ = 0, window_pos_ = 0;
   double window_sum_ = 0.0;
-  UpdateReport last_report_;
 };
 
 }  // namespace wheelins

@@ -18,6 +18,8 @@ std::string NavigatorOptions::describe() const {
     << "position constraint:        " << onoff(fusion.position_constraint) << ", every "
     << fusion.position_update_interval << " s, sigma " << fusion.position_std << " m\n"
     << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
+    << "filter structure:           "
+    << (fusion.centralized ? "centralized (one joint covariance)" : "distributed (paper)") << "\n"
     << "innovation gates (vel/pos): " << wheel.gate << " / " << fusion.position_gate
     << " (0 = off)\n"
     << "initial sigma:              position " << wheel.init.position << " m, velocity "
@@ -100,6 +102,7 @@ void Navigator::process(int index, const ImuSample& raw) {
     start_navigation(manifest_.static_end);
   }
   s.propagate(b);
+  if (joint_) joint_->propagate(index, s.ekf().last_F(), s.ekf().noise(), b.dt);
 
   // Updates when every subsystem has reached the scheduled time.
   const double t_all = min_time();
@@ -136,6 +139,13 @@ void Navigator::start_navigation(double t0) {
                        "] s: the alignment needs a static period covered by the data");
     subs_[i]->start(static_[i], manifest_.initial_heading, t0);
   }
+  if (opt_.fusion.centralized && subs_.size() > 1) {
+    joint_ = make_joint_covariance(subsystem_count());
+    for (int i = 0; i < subsystem_count(); ++i) {
+      joint_->set_block(i, subs_[i]->ekf().covariance());
+      subs_[i]->ekf().set_external_covariance(true);
+    }
+  }
   navigating_ = true;
   stats_.t_start = t0;
   next_output_t_ = t0;
@@ -161,24 +171,77 @@ void Navigator::velocity_updates() {
     if (!rep.accepted) ++stats_.velocity_rejected;
     stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
   };
-  for (WheelIns* w : wheels_) {
-    WheelVelocityInput in = w->own_velocity_input();
-    if (opt_.fusion.speed == SpeedSharing::kMean && wheels_.size() > 1) {
-      // Its own speed enters the mean with weight 1/n.
-      in.measured_speed = mean_speed;
-      in.dspeed_dbgx /= n;
-      in.dspeed_dsgx /= n;
+  for (int i = 0; i < subsystem_count(); ++i) {
+    if (subs_[i]->is_wheel()) {
+      const auto& w = static_cast<const WheelIns&>(*subs_[i]);
+      WheelVelocityInput in = w.own_velocity_input();
+      if (opt_.fusion.speed == SpeedSharing::kMean && wheels_.size() > 1) {
+        // Its own speed enters the mean with weight 1/n.
+        in.measured_speed = mean_speed;
+        in.dspeed_dbgx /= n;
+        in.dspeed_dsgx /= n;
+      }
+      const WheelVelocityModel m = wheel_velocity_model(in);
+      count(fuse(i, m.H, m.innovation(), w.velocity_noise(), w.velocity_gate()));
+    } else {
+      // The mean speed of the wheels is the speed of the mean of their centres (o for a
+      // symmetric pair; the wheel centre itself for one wheel).
+      const BodyVelocityModel m = body_->velocity_model(mean_speed, mean_point);
+      count(fuse(i, m.H, m.innovation(), body_->velocity_noise(), body_->velocity_gate()));
     }
-    count(w->velocity_update(in));
-  }
-  if (body_) {
-    // The mean speed of the wheels is the speed of the mean of their centres (o for a
-    // symmetric pair; the wheel centre itself for one wheel).
-    count(body_->velocity_update(mean_speed, mean_point));
   }
 }
 
+UpdateReport Navigator::fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate) {
+  if (!joint_) return subs_[i]->ekf().update<3>(H, dz, R, gate);
+  std::array<const H3*, kMaxCentralized> blocks{};
+  blocks[i] = &H;
+  std::array<Vec21, kMaxCentralized> dx;
+  const UpdateReport rep = joint_->update(blocks, dz, R, gate, dx);
+  if (rep.accepted)
+    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
+  return rep;
+}
+
+UpdateReport Navigator::fuse_position_centralized(int i, double gate) {
+  // dz_i = r_o^i - sum_j k_j r_o^j depends on every subsystem's state:
+  // H = (1 - k_i) H_i for block i and -k_j H_j for the others.
+  std::array<ReferencePointModel, kMaxCentralized> m;
+  std::array<H3, kMaxCentralized> h;
+  std::array<const H3*, kMaxCentralized> blocks{};
+  Vec3 fused = Vec3::Zero();
+  for (int j = 0; j < subsystem_count(); ++j) {
+    m[j] = reference_point_model(subs_[j]->reference_point_input());
+    fused += weights_[j] * m[j].r_o;
+  }
+  for (int j = 0; j < subsystem_count(); ++j) {
+    h[j] = ((j == i ? 1.0 : 0.0) - weights_[j]) * m[j].H;
+    blocks[j] = &h[j];
+  }
+  const double sd = opt_.fusion.position_std;
+  std::array<Vec21, kMaxCentralized> dx;
+  const UpdateReport rep =
+      joint_->update(blocks, m[i].r_o - fused, Mat3::Identity() * sd * sd, gate, dx);
+  if (rep.accepted)
+    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
+  return rep;
+}
+
+Mat21 Navigator::covariance(int i) const {
+  return joint_ ? joint_->block(i) : subs_[i]->ekf().covariance();
+}
+
 void Navigator::position_update() {
+  if (joint_) {
+    // Sequentially, each re-evaluated at the state the previous one left.
+    for (int i = 0; i < subsystem_count(); ++i) {
+      const UpdateReport rep = fuse_position_centralized(i, opt_.fusion.position_gate);
+      ++stats_.position_updates;
+      if (!rep.accepted) ++stats_.position_rejected;
+      stats_.max_position_test_ratio = std::max(stats_.max_position_test_ratio, rep.test_ratio);
+    }
+    return;
+  }
   // Algorithm 1: o in every subsystem's frame, their weighted mean as the measurement.
   std::vector<ReferencePointModel> models;
   models.reserve(subs_.size());
@@ -202,7 +265,7 @@ void Navigator::position_update() {
 TrajectoryRecord Navigator::subsystem_record(int i) const {
   const Subsystem& s = *subs_[i];
   const StrapdownEkf& ekf = s.ekf();
-  const Mat21& P = ekf.covariance();
+  const Mat21 P = covariance(i);
   TrajectoryRecord r;
   r.t = ekf.state().t;
   const ReferencePointModel m = reference_point_model(s.reference_point_input());

@@ -19,6 +19,7 @@
 
 #include "wheelins/filter/body_ins.hpp"
 #include "wheelins/filter/wheel_ins.hpp"
+#include "wheelins/fusion/centralized.hpp"
 #include "wheelins/io/trajectory.hpp"
 
 namespace wheelins {
@@ -37,6 +38,8 @@ struct FusionOptions {
   double position_std = 0.2;              ///< [m] (Table 9)
   double position_gate = 0.0;             ///< test-ratio gate; 0 = off
   std::vector<double> weights;            ///< k_i of eq. (9); empty = equal
+  /// One joint covariance over all IMUs (Section VI-B-2) instead of one per subsystem.
+  bool centralized = false;
 };
 
 struct NavigatorOptions {
@@ -93,6 +96,11 @@ class Navigator {
   void start_navigation(double t0);
   void velocity_updates();
   void position_update();
+  /// Fuses dz = H dx_i + e into subsystem i (distributed) or the joint state (centralized).
+  UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
+  /// Position constraint of subsystem i in the centralized filter (depends on every state).
+  UpdateReport fuse_position_centralized(int i, double gate);
+  Mat21 covariance(int i) const;
   TrajectoryRecord subsystem_record(int i) const;
   double min_time() const;
 
@@ -105,6 +113,7 @@ class Navigator {
   BodyIns* body_ = nullptr;
   std::vector<double> weights_;
   std::vector<StaticAccumulator> static_;
+  std::unique_ptr<JointCovariance> joint_;
   bool navigating_ = false;
   double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
   NavigatorStats stats_;

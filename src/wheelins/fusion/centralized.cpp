@@ -1,0 +1,92 @@
+#include "wheelins/fusion/centralized.hpp"
+
+#include <string>
+
+#include "wheelins/nav/types.hpp"
+
+namespace wheelins {
+namespace {
+
+template <int N>
+class FixedJointCovariance final : public JointCovariance {
+  static constexpr int D = kStateDim * N;
+  using MatD = Eigen::Matrix<double, D, D>;
+  using MatD3 = Eigen::Matrix<double, D, 3>;
+  using H3D = Eigen::Matrix<double, 3, D>;
+
+ public:
+  FixedJointCovariance() { P_.setZero(); }
+  int size() const override { return N; }
+
+  void set_block(int i, const Mat21& P) override {
+    P_.template block<kStateDim, kStateDim>(kStateDim * i, kStateDim * i) = P;
+  }
+  Mat21 block(int i) const override {
+    return P_.template block<kStateDim, kStateDim>(kStateDim * i, kStateDim * i);
+  }
+
+  void propagate(int i, const Mat21& F, const ProcessNoise& q, double dt) override {
+    // Phi_big = diag(I, .., Phi_i, .., I): row block i <- Phi_i * row block i,
+    // column block i <- column block i * Phi_i^T, plus Qd_i on the diagonal block.
+    const Mat21 Phi = transition_matrix(F, dt);
+    const int o = kStateDim * i;
+    const Eigen::Matrix<double, kStateDim, D> rows = Phi * P_.template middleRows<kStateDim>(o);
+    P_.template middleRows<kStateDim>(o) = rows;
+    const Eigen::Matrix<double, D, kStateDim> cols =
+        P_.template middleCols<kStateDim>(o) * Phi.transpose();
+    P_.template middleCols<kStateDim>(o) = cols;
+    auto Pii = P_.template block<kStateDim, kStateDim>(o, o);
+    Pii += discrete_noise(Phi, q, dt);
+    const Mat21 sym = 0.5 * (Mat21(Pii) + Mat21(Pii).transpose());
+    Pii = sym;
+  }
+
+  UpdateReport update(const std::array<const H3*, kMaxCentralized>& H, const Vec3& dz,
+                      const Mat3& R, double gate,
+                      std::array<Vec21, kMaxCentralized>& dx) override {
+    H3D Hb = H3D::Zero();
+    for (int j = 0; j < N; ++j)
+      if (H[j]) Hb.template middleCols<kStateDim>(kStateDim * j) = *H[j];
+    const MatD3 PHt = P_ * Hb.transpose();
+    const Mat3 S = Hb * PHt + R;
+    const Eigen::LLT<Mat3> llt(S);
+    UpdateReport rep;
+    rep.dim = 3;
+    for (int k = 0; k < 3; ++k) {
+      rep.innovation[k] = dz(k);
+      rep.innovation_var[k] = S(k, k);
+    }
+    for (int j = 0; j < N; ++j) dx[j].setZero();
+    if (llt.info() != Eigen::Success) return rep;
+    rep.nis = dz.dot(llt.solve(dz));
+    rep.test_ratio = rep.nis / kChi2_999[3];
+    if (gate > 0.0 && rep.test_ratio > gate) return rep;
+    const MatD3 K = llt.solve(PHt.transpose()).transpose();
+    const Eigen::Matrix<double, D, 1> dxb = K * dz;
+    // P <- P - K S K^T  (= (I - K H) P for the optimal gain), kept symmetric.
+    P_.noalias() -= K * PHt.transpose();
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    for (int j = 0; j < N; ++j) dx[j] = dxb.template segment<kStateDim>(kStateDim * j);
+    rep.accepted = true;
+    return rep;
+  }
+
+ private:
+  MatD P_;
+};
+
+}  // namespace
+
+std::unique_ptr<JointCovariance> make_joint_covariance(int n) {
+  switch (n) {
+    case 2: return std::make_unique<FixedJointCovariance<2>>();
+    case 3: return std::make_unique<FixedJointCovariance<3>>();
+    case 4: return std::make_unique<FixedJointCovariance<4>>();
+    case 5: return std::make_unique<FixedJointCovariance<5>>();
+    default:
+      throw InputError("the centralized filter takes 2 to " + std::to_string(kMaxCentralized) +
+                       " IMUs, " + std::to_string(n) + " were selected");
+  }
+}
+
+}  // namespace wheelins

@@ -1,0 +1,38 @@
+// The centralized filter's covariance (paper Section VI-B-2): one EKF whose
+// error state stacks the 21 states of all N IMUs, so the cross-correlations the
+// distributed filter ignores are carried by the joint covariance. The nominal
+// states stay in the subsystems; this class holds the (21N x 21N) covariance,
+// fixed-size (N = 2..5), and applies the same process and measurement models.
+#pragma once
+
+#include <array>
+#include <memory>
+
+#include "wheelins/filter/ekf_update.hpp"
+#include "wheelins/filter/error_model.hpp"
+
+namespace wheelins {
+
+constexpr int kMaxCentralized = 5;
+using H3 = Eigen::Matrix<double, 3, kStateDim>;
+
+class JointCovariance {
+ public:
+  virtual ~JointCovariance() = default;
+  virtual int size() const = 0;
+  /// Block-diagonal start from the subsystems' own initial covariances.
+  virtual void set_block(int i, const Mat21& P) = 0;
+  virtual Mat21 block(int i) const = 0;
+  /// Subsystem i advanced by one epoch (F_i over dt); the others did not move.
+  virtual void propagate(int i, const Mat21& F, const ProcessNoise& q, double dt) = 0;
+  /// Fuses dz = sum_j H_j dx_j + e (H[j] == nullptr: no dependence on subsystem j),
+  /// writing each subsystem's error estimate into dx[j].
+  virtual UpdateReport update(const std::array<const H3*, kMaxCentralized>& H, const Vec3& dz,
+                              const Mat3& R, double gate,
+                              std::array<Vec21, kMaxCentralized>& dx) = 0;
+};
+
+/// A joint covariance for n subsystems (2 <= n <= kMaxCentralized); InputError otherwise.
+std::unique_ptr<JointCovariance> make_joint_covariance(int n);
+
+}  // namespace wheelins
