@@ -1,0 +1,102 @@
+#include "wheelins/fusion/run.hpp"
+
+#include <chrono>
+
+#include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/imu_file.hpp"
+#include "wheelins/util/progress.hpp"
+
+namespace wheelins {
+namespace fs = std::filesystem;
+
+namespace {
+const char* extension(TrajectoryFormat f) {
+  switch (f) {
+    case TrajectoryFormat::kTum: return ".tum";
+    case TrajectoryFormat::kKml: return ".kml";
+    default: return ".csv";
+  }
+}
+bool multi(const RunRequest& r) { return r.modules.size() > 1 && r.write_subsystems; }
+}  // namespace
+
+std::vector<fs::path> run_output_files(const RunRequest& r) {
+  std::vector<fs::path> files;
+  if (r.output_dir.empty()) return files;
+  for (TrajectoryFormat f : r.formats) files.push_back(r.output_dir / (std::string("trajectory") + extension(f)));
+  if (multi(r))
+    for (const auto& m : r.modules) files.push_back(r.output_dir / (m + ".csv"));
+  return files;
+}
+
+RunResult run_navigation(const RunRequest& r) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  // Refuse before doing any work if results would be overwritten.
+  const std::vector<fs::path> outputs = run_output_files(r);
+  for (const auto& f : outputs) check_output_target(f, r.overwrite);
+
+  // Readers for the selected modules only, merged by time.
+  std::vector<std::unique_ptr<ImuStream>> readers;
+  std::uint64_t total_rows = 0;
+  for (const auto& name : r.modules) {
+    const ModuleSpec* spec = r.manifest.find(name);
+    if (!spec) throw InputError("'" + r.manifest.path.string() + "': no module named '" + name + "'");
+    const fs::path file = r.manifest.resolve(spec->file);
+    readers.push_back(std::make_unique<ImuFileReader>(file, imu_read_options(*spec, r.warn)));
+    std::error_code ec;
+    if (spec->layout == FileLayout::kBinary) total_rows += fs::file_size(file, ec) / (7 * sizeof(double));
+  }
+  ImuMerger merger(std::move(readers));
+
+  // Writers: the vehicle solution in every format, the subsystems as CSV.
+  if (!r.output_dir.empty()) fs::create_directories(r.output_dir);
+  TrajectoryWriterOptions wopt;
+  wopt.overwrite = r.overwrite;
+  std::vector<std::unique_ptr<TrajectoryWriter>> vehicle, subsystems;
+  if (!r.output_dir.empty()) {
+    for (TrajectoryFormat f : r.formats)
+      vehicle.push_back(make_trajectory_writer(
+          f, r.output_dir / (std::string("trajectory") + extension(f)), wopt));
+    if (multi(r))
+      for (const auto& m : r.modules)
+        subsystems.push_back(
+            make_trajectory_writer(TrajectoryFormat::kCsv, r.output_dir / (m + ".csv"), wopt));
+  }
+
+  Navigator nav(r.manifest, r.modules, r.nav, [&](int stream, const TrajectoryRecord& rec) {
+    if (stream == 0) {
+      for (auto& w : vehicle) w->write(rec);
+      if (r.on_record) r.on_record(rec);
+    } else if (!subsystems.empty()) {
+      subsystems[stream - 1]->write(rec);
+    }
+  });
+
+  Progress progress("navigating", total_rows, r.progress);
+  std::size_t index = 0;
+  ImuSample s;
+  std::uint64_t n = 0;
+  while (merger.next(index, s)) {
+    nav.process(static_cast<int>(index), s);
+    if ((++n & 0x3FFF) == 0) progress.update(n);
+    if (r.max_duration > 0 && nav.navigating() &&
+        s.t - nav.stats().t_start >= r.max_duration)
+      break;
+  }
+  progress.finish();
+  if (!nav.navigating())
+    throw InputError("the data end before the static period [" +
+                     std::to_string(r.manifest.static_start) + ", " +
+                     std::to_string(r.manifest.static_end) + "] s does: nothing to navigate");
+
+  RunResult result;
+  for (auto& w : vehicle) w->commit();
+  for (auto& w : subsystems) w->commit();
+  result.files = outputs;
+  result.stats = nav.stats();
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return result;
+}
+
+}  // namespace wheelins

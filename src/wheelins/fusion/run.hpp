@@ -1,0 +1,43 @@
+// One navigation run end to end: the selected modules' files are streamed and
+// merged by time, the navigator runs, and the trajectories are written (each file
+// appears complete or not at all; existing results are kept unless overwrite).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "wheelins/fusion/navigator.hpp"
+#include "wheelins/io/diagnostics.hpp"
+#include "wheelins/io/trajectory.hpp"
+
+namespace wheelins {
+
+struct RunRequest {
+  Manifest manifest;
+  std::vector<std::string> modules;  ///< the first drives the output epochs
+  NavigatorOptions nav;
+  std::filesystem::path output_dir;  ///< empty: nothing is written (the sink still runs)
+  std::vector<TrajectoryFormat> formats{TrajectoryFormat::kCsv, TrajectoryFormat::kTum,
+                                        TrajectoryFormat::kKml};
+  bool overwrite = false;
+  bool write_subsystems = true;      ///< also <module>.csv per subsystem (multi-IMU runs)
+  bool progress = true;              ///< a progress line on a terminal
+  double max_duration = 0.0;         ///< stop after this much navigation [s]; 0 = all data
+  WarningSink warn;
+  /// Called for every vehicle record (e.g. to evaluate in memory); may be empty.
+  std::function<void(const TrajectoryRecord&)> on_record;
+};
+
+struct RunResult {
+  NavigatorStats stats;
+  double wall_seconds = 0.0;
+  std::vector<std::filesystem::path> files;  ///< what was written
+};
+
+RunResult run_navigation(const RunRequest& request);
+
+/// The files a run would write (to refuse early, before any work, if they exist).
+std::vector<std::filesystem::path> run_output_files(const RunRequest& request);
+
+}  // namespace wheelins
