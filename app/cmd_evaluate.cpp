@@ -1,0 +1,189 @@
+// `wheelins evaluate`: accuracy of a trajectory against a truth file (paper VI-B).
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "wheelins/eval/metrics.hpp"
+#include "wheelins/io/atomic_file.hpp"
+#include "wheelins/nav/types.hpp"
+
+namespace {
+
+using namespace wheelins;
+
+struct Options {
+  std::string truth, traj, format = "auto", truth_layout = "auto";
+  double segment = 100.0;
+  double max_gap = 5.0;
+  bool align = false;
+  bool force = false;
+  std::string json, series, origin;
+};
+
+earth::Geodetic parse_origin(const std::string& text) {
+  std::vector<double> v;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t k = text.find(',', start);
+    std::string part = text.substr(start, k == std::string::npos ? std::string::npos : k - start);
+    while (!part.empty() && part.front() == ' ') part.erase(part.begin());
+    while (!part.empty() && part.back() == ' ') part.pop_back();
+    double x = 0.0;
+    const auto r = std::from_chars(part.data(), part.data() + part.size(), x);
+    if (part.empty() || r.ec != std::errc() || r.ptr != part.data() + part.size() ||
+        !std::isfinite(x))
+      throw InputError("--origin '" + text + "': '" + part +
+                       "' is not a number (expected lat_deg,lon_deg,h_m)");
+    v.push_back(x);
+    if (k == std::string::npos) break;
+    start = k + 1;
+  }
+  if (v.size() != 3)
+    throw InputError("--origin '" + text + "': expected 3 values lat_deg,lon_deg,h_m, got " +
+                     std::to_string(v.size()));
+  if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 180.0)
+    throw InputError("--origin '" + text + "': latitude/longitude out of range");
+  return {v[0] * kDeg, v[1] * kDeg, v[2]};
+}
+
+std::string fmt(double v, int decimals, const char* unit = "") {
+  if (!std::isfinite(v)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f%s", decimals, v, unit);
+  return buf;
+}
+
+void print_table(std::ostream& os, const eval::EvalResult& r, const std::string& truth_layout) {
+  auto row = [&](const char* name, const std::string& value) {
+    char buf[48];
+    std::snprintf(buf, sizeof(buf), "  %-26s", name);
+    os << buf << value << "\n";
+  };
+  os << "trajectory: " << r.traj_file << " (" << r.traj_format << ", " << r.traj_records
+     << " records)\n";
+  os << "truth:      " << r.truth_file << " (" << truth_layout << ", " << r.truth_records
+     << " records)\n";
+  std::string epochs = std::to_string(r.epochs) + " truth epochs";
+  if (r.skipped_outside || r.skipped_gap)
+    epochs += " (" + std::to_string(r.skipped_outside) + " outside the trajectory, " +
+              std::to_string(r.skipped_gap) + " in gaps)";
+  row("evaluated", epochs);
+  row("duration", fmt(r.duration, 2, " s") + "  (" + fmt(r.t_start, 3) + " .. " +
+                      fmt(r.t_end, 3) + ")");
+  row("distance", fmt(r.distance, 1, " m"));
+  std::string drift = fmt(r.drift_rate * 100.0, 3, " %");
+  if (r.drift_curve.empty())
+    drift += "  (distance shorter than one " + fmt(r.segment_length, 0, " m") + " segment)";
+  else
+    drift += "  (mean of " + std::to_string(r.drift_curve.size()) + " segments of " +
+             fmt(r.segment_length, 0, " m") + ")";
+  row("position drift rate", drift);
+  row("heading RMSE", r.has_heading ? fmt(r.heading_rmse / kDeg, 3, " deg") +
+                                          "  (max " + fmt(r.heading_max_abs / kDeg, 2, " deg") + ")"
+                                    : "n/a (no heading in truth or trajectory)");
+  row("max horizontal error", fmt(r.max_error, 3, " m"));
+  row("final horizontal error", fmt(r.final_error, 3, " m"));
+  row("RMS horizontal error", fmt(r.rms_error, 3, " m"));
+  if (r.has_sigma)
+    row("within 3 sigma (horiz.)", fmt(r.within_3sigma * 100.0, 1, " %") + "  (mean NEES " +
+                                        fmt(r.mean_nees, 2) + ", expected 2; " +
+                                        std::to_string(r.sigma_epochs) + " epochs)");
+  else
+    row("within 3 sigma (horiz.)", "n/a (no north/east std in the trajectory)");
+  if (r.aligned)
+    row("alignment", "shift n/e/d " + fmt(r.align_offset.x(), 3) + " / " +
+                         fmt(r.align_offset.y(), 3) + " / " + fmt(r.align_offset.z(), 3) +
+                         " m, " +
+                         (r.align_rotated ? "rotation " + fmt(r.align_yaw / kDeg, 3, " deg")
+                                          : std::string("no rotation (heading unavailable)")));
+}
+
+void write_series(const std::string& file, const eval::EvalResult& r, bool force) {
+  AtomicTextFile out(file, force);
+  out.write(
+      "t_s,distance_m,err_n_m,err_e_m,err_d_m,err_h_m,heading_err_deg,sigma_h_m,nees_h\n");
+  for (const auto& e : r.series) {
+    std::string& b = out.buffer();
+    const double vals[9] = {e.t,           e.distance,     e.err_ned.x(),
+                            e.err_ned.y(), e.err_ned.z(),  e.err_h,
+                            e.heading_err / kDeg, e.sigma_h, e.nees_h};
+    for (int k = 0; k < 9; ++k) {
+      if (k) b += ',';
+      append_double(b, vals[k], k == 0 ? 0 : 10);
+    }
+    b += '\n';
+    out.maybe_flush();
+  }
+  out.commit();
+}
+
+const bool registered = cli::register_command(
+    30, "evaluate", "Accuracy of a trajectory against a truth file (drift rate, heading RMSE)",
+    [](CLI::App& sub) {
+      auto o = std::make_shared<Options>();
+      sub.add_option("--truth", o->truth, "Truth file: GINS.bin (11 or 5 float64 columns)")
+          ->required();
+      sub.add_option("--traj", o->traj, "Trajectory to judge (wheelins CSV, TUM, Wheel-INS traj.txt)")
+          ->required();
+      sub.add_option("--format", o->format, "Trajectory format: auto|csv|tum|wheelins-traj")
+          ->capture_default_str();
+      sub.add_option("--truth-layout", o->truth_layout, "Truth layout: auto|gins11|pos5")
+          ->capture_default_str();
+      sub.add_option("--segment", o->segment, "Drift-rate segment length l [m]")
+          ->capture_default_str();
+      sub.add_option("--max-gap", o->max_gap,
+                     "Largest trajectory time gap interpolated across [s]")
+          ->capture_default_str();
+      sub.add_flag("--align", o->align,
+                   "Shift and rotate the trajectory so its first epoch matches the truth "
+                   "(for results in another tool's frame)");
+      sub.add_option("--json", o->json, "Write the metrics as JSON to FILE ('-' for stdout)");
+      sub.add_option("--series", o->series, "Write per-epoch errors as CSV to FILE");
+      sub.add_option("--origin", o->origin,
+                     "Local frame origin lat_deg,lon_deg,h_m (default: the first truth record); "
+                     "north/east/down-only trajectories (TUM, traj.txt) must be in this frame");
+      sub.add_flag("--force", o->force, "Overwrite existing --json / --series files");
+      return [o]() {
+        const TruthLayout layout = truth_layout_from_name(o->truth_layout);
+        const TrajectoryFormat format = trajectory_format_from_name(o->format);
+        if (format == TrajectoryFormat::kKml)
+          throw InputError("--format kml: KML is written for viewing only and cannot be evaluated");
+        if (!o->json.empty() && o->json != "-") check_output_target(o->json, o->force);
+        if (!o->series.empty()) check_output_target(o->series, o->force);
+
+        const TruthData truth = read_truth(o->truth, layout);
+        const TrajectoryData traj = read_trajectory(o->traj, format);
+        const earth::LocalFrame frame(o->origin.empty() ? truth.records.front().lla
+                                                        : parse_origin(o->origin));
+        eval::EvalOptions opt;
+        opt.segment_length = o->segment;
+        opt.max_gap = o->max_gap;
+        opt.align = o->align;
+        const eval::EvalResult res = eval::evaluate(truth, traj, frame, opt);
+
+        // With JSON on stdout the table goes to stderr, so stdout stays parseable.
+        std::ostream& table = o->json == "-" ? std::cerr : std::cout;
+        print_table(table, res, truth_layout_name(truth.layout));
+        if (!traj.has_lla && !o->align && o->origin.empty())
+          table << "note: " << o->traj << " has north/east/down only; it was taken to be relative "
+                << "to the first truth record (use --origin or --align otherwise)\n";
+        const std::string json = eval::to_json(res);
+        if (o->json == "-") {
+          std::cout << json;
+        } else if (!o->json.empty()) {
+          AtomicTextFile out(o->json, o->force);
+          out.write(json);
+          out.commit();
+        }
+        if (!o->series.empty()) write_series(o->series, res, o->force);
+        return 0;
+      };
+    });
+
+}  // namespace

@@ -1,0 +1,108 @@
+// Accuracy of a navigation result against a reference trajectory (paper
+// Section VI-B): position drift rate, heading RMSE, and consistency figures.
+//
+// Definitions (all horizontal quantities use north/east in the local NED frame):
+//  * Sampling: the trajectory is interpolated to the truth epochs, not the other
+//    way round. The reference defines where and when accuracy is measured, so the
+//    figures do not depend on the output rate of the tool being judged (a 1 Hz and
+//    a 200 Hz result of the same filter score alike), and interpolating the
+//    usually denser navigation output costs less than interpolating the truth.
+//    Position, velocity-free: linear in NED; heading: along the shorter arc; 1-sigma
+//    values: linear. Truth epochs outside the trajectory's time span are skipped
+//    (no extrapolation), as are epochs whose bracketing trajectory records are more
+//    than `max_gap` seconds apart (an output gap is not evidence of accuracy).
+//  * Distance: s(t) = horizontal path length along the truth, accumulated over
+//    consecutive truth records from the first evaluated epoch (horizontal, so the
+//    height noise of the reference does not add distance while standing).
+//  * Horizontal error: e_h = |(n_traj - n_truth, e_traj - e_truth)|.
+//  * Drift rate (paper VI-B): with l the segment length and K = floor(s_total / l),
+//    for k = 1..K:  r_k = max{ e_h(t) : s(t) <= k l } / (k l);
+//    the drift rate is mean(r_1..r_K). Undefined (NaN) when s_total < l.
+//  * Heading error: wrap(heading_traj - heading_truth) into (-180, 180] deg;
+//    RMSE over the evaluated epochs. Needs truth attitude (not in 5-column truth)
+//    and a trajectory heading.
+//  * 1-sigma consistency (when the trajectory carries north/east std):
+//    P = diag(sigma_n^2, sigma_e^2) (rotated with the trajectory when aligned),
+//    sigma_h = sqrt(trace P) = sqrt(sigma_n^2 + sigma_e^2), the RMS of e_h that P
+//    predicts. "Within 3 sigma" counts epochs with e_h <= 3 sigma_h; for a
+//    consistent filter this fraction is >= 8/9 whatever P (Markov's inequality on
+//    e_h^2) and 1 - exp(-4.5) = 0.989 for sigma_n = sigma_e.
+//    Horizontal NEES = [dn de] P^-1 [dn de]^T, mean over epochs (2 if consistent).
+//    Epochs with sigma_n or sigma_e not positive and finite are left out of both.
+//  * Alignment (optional, for results in another tool's frame): the trajectory is
+//    rotated about the vertical through its position at the first evaluated epoch
+//    by dpsi = wrap(heading_truth - heading_traj) there, and shifted so that
+//    position equals the truth's; heading_traj += dpsi. Without headings on both
+//    sides only the shift is applied (reported).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "wheelins/io/trajectory.hpp"
+#include "wheelins/io/truth.hpp"
+
+namespace wheelins::eval {
+
+struct EvalOptions {
+  double segment_length = 100.0;  ///< l [m] of the drift rate
+  bool align = false;             ///< shift + rotate the trajectory onto the truth at the start
+  double max_gap = 5.0;           ///< [s] largest trajectory gap interpolated across
+};
+
+/// The comparison at one evaluated truth epoch.
+struct EpochError {
+  double t = 0.0;
+  double distance = 0.0;  ///< s(t) [m]
+  Vec3 err_ned = Vec3::Zero();  ///< trajectory - truth [m]
+  double err_h = 0.0;           ///< horizontal error [m]
+  double heading_err = 0.0;     ///< [rad], NaN when not available
+  double sigma_h = 0.0;         ///< [m], NaN when not available
+  double nees_h = 0.0;          ///< NaN when not available
+};
+
+struct EvalResult {
+  std::string truth_file, traj_file, traj_format;
+  std::size_t truth_records = 0, traj_records = 0;
+  std::size_t epochs = 0;             ///< evaluated truth epochs
+  std::size_t skipped_outside = 0;    ///< truth epochs outside the trajectory's time span
+  std::size_t skipped_gap = 0;        ///< truth epochs inside a trajectory gap > max_gap
+  double t_start = 0.0, t_end = 0.0, duration = 0.0;  ///< evaluated span [s]
+  double distance = 0.0;              ///< s_total [m]
+  double segment_length = 100.0;
+  std::vector<double> drift_curve;    ///< r_k, k = 1..K (fractions, not %)
+  double drift_rate = 0.0;            ///< mean r_k (fraction); NaN if K = 0
+  bool has_heading = false;
+  double heading_rmse = 0.0;          ///< [rad]; NaN without headings
+  double heading_max_abs = 0.0;       ///< [rad]; NaN without headings
+  double max_error = 0.0, final_error = 0.0, rms_error = 0.0;  ///< horizontal [m]
+  bool has_sigma = false;
+  std::size_t sigma_epochs = 0;       ///< epochs with usable north/east sigma
+  double within_3sigma = 0.0;         ///< fraction in [0, 1]; NaN without sigma
+  double mean_nees = 0.0;             ///< NaN without sigma
+  bool aligned = false;
+  bool align_rotated = false;         ///< heading part applied
+  double align_yaw = 0.0;             ///< dpsi [rad]
+  Vec3 align_offset = Vec3::Zero();   ///< truth - trajectory position at the pivot [m]
+  std::vector<EpochError> series;     ///< one entry per evaluated epoch
+};
+
+/// r_k = max{err[i] : s[i] <= k l} / (k l) for k = 1..floor(s.back() / l), with s
+/// non-decreasing distances from 0. Empty when s.back() < l.
+std::vector<double> drift_rate_curve(const std::vector<double>& s, const std::vector<double>& err,
+                                     double segment_length);
+
+/// Compares `traj` with `truth` in `frame` (the local NED frame both are expressed
+/// in). Trajectory records with lat/lon/h are mapped into `frame`; records with
+/// only north/east/down are taken as already in `frame`. Throws InputError (naming
+/// the files) when no truth epoch falls inside the trajectory, or for options out
+/// of range.
+EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
+                    const earth::LocalFrame& frame, const EvalOptions& options = {});
+
+/// The result as a JSON object (angles in degrees, rates in percent; NaN -> null;
+/// the per-epoch series is left out).
+std::string to_json(const EvalResult& result);
+
+}  // namespace wheelins::eval
