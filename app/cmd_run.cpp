@@ -1,0 +1,134 @@
+// `wheelins run`: navigate one configuration of a dataset and write its trajectory.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "cli.hpp"
+#include "wheelins/eval/metrics.hpp"
+#include "wheelins/fusion/presets.hpp"
+#include "wheelins/fusion/run.hpp"
+#include "wheelins/fusion/run_config.hpp"
+#include "wheelins/io/truth.hpp"
+
+namespace {
+using namespace wheelins;
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+struct RunArgs {
+  std::string config_file;
+  std::string manifest;
+  std::string configuration;
+  std::string chips;
+  std::string modules;
+  std::string out;
+  std::string formats;
+  std::string speed;
+  bool centralized = false;
+  bool no_constraint = false;
+  bool force = false;
+  bool quiet = false;
+  double duration = 0.0;
+  double output_interval = -1.0;
+};
+
+int run(const RunArgs& a) {
+  RunConfig cfg = a.config_file.empty() ? RunConfig{} : load_run_config(a.config_file, stderr_sink());
+  if (!a.manifest.empty()) cfg.manifest = a.manifest;
+  if (cfg.manifest.empty())
+    throw InputError("no dataset: give a run config (wheelins run CONFIG.yaml) or --manifest FILE");
+  if (!a.configuration.empty()) cfg.configuration = a.configuration;
+  if (!a.chips.empty()) cfg.chips = split_list(a.chips);
+  if (!a.modules.empty()) cfg.modules = split_list(a.modules);
+  if (!a.out.empty()) cfg.output_dir = a.out;
+  if (!a.formats.empty()) {
+    cfg.formats.clear();
+    for (const auto& f : split_list(a.formats)) cfg.formats.push_back(trajectory_format_from_name(f));
+  }
+  if (!a.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(a.speed);
+  if (a.centralized) cfg.nav.fusion.centralized = true;
+  if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
+  if (a.force) cfg.overwrite = true;
+  if (a.duration > 0) cfg.max_duration = a.duration;
+  if (a.output_interval >= 0) cfg.nav.output_interval = a.output_interval;
+
+  RunRequest req = make_run_request(cfg, stderr_sink());
+  req.progress = !a.quiet;
+
+  // Keep the vehicle solution at 20 Hz in memory to evaluate against the truth.
+  TrajectoryData traj;
+  traj.has_ned = traj.has_lla = traj.has_heading = traj.has_pos_std = true;
+  double next_keep = -1e300;
+  req.on_record = [&](const TrajectoryRecord& r) {
+    if (r.t + 1e-9 < next_keep) return;
+    traj.records.push_back(r);
+    next_keep = r.t + 0.05;
+  };
+
+  std::cout << "wheelins run: " << cfg.configuration << " [";
+  for (std::size_t i = 0; i < req.modules.size(); ++i) std::cout << (i ? ", " : "") << req.modules[i];
+  std::cout << "] on '" << req.manifest.path.string() << "'\n";
+  if (!a.quiet) std::cout << req.nav.describe();
+
+  const RunResult res = run_navigation(req);
+  const NavigatorStats& st = res.stats;
+  const double nav_s = st.t_end - st.t_start;
+  std::printf("\nnavigated %.1f s (%llu epochs) in %.2f s wall: %.2f us per epoch, %.0fx real time\n",
+              nav_s, static_cast<unsigned long long>(st.epochs), res.wall_seconds,
+              1e6 * res.wall_seconds / std::max<double>(1.0, static_cast<double>(st.epochs)),
+              nav_s / std::max(1e-9, res.wall_seconds));
+  std::printf("velocity updates: %llu (%llu rejected, max test ratio %.2f)\n",
+              static_cast<unsigned long long>(st.velocity_updates),
+              static_cast<unsigned long long>(st.velocity_rejected), st.max_velocity_test_ratio);
+  if (st.position_updates)
+    std::printf("position-constraint updates: %llu (%llu rejected, max test ratio %.2f)\n",
+                static_cast<unsigned long long>(st.position_updates),
+                static_cast<unsigned long long>(st.position_rejected), st.max_position_test_ratio);
+  for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
+
+  if (req.manifest.truth_file) {
+    const TruthData truth = read_truth(req.manifest.resolve(*req.manifest.truth_file));
+    const eval::EvalResult e = eval::evaluate(truth, traj, earth::LocalFrame(req.manifest.origin));
+    std::printf("\nagainst the truth (%s):\n", truth.file.string().c_str());
+    std::printf("  distance            %10.1f m\n", e.distance);
+    std::printf("  drift rate          %10.3f %% of distance (l = %.0f m)\n", 100.0 * e.drift_rate,
+                e.segment_length);
+    if (e.has_heading) std::printf("  heading RMSE        %10.3f deg\n", e.heading_rmse / kDeg);
+    std::printf("  max / final error   %6.2f / %.2f m\n", e.max_error, e.final_error);
+    if (e.has_sigma)
+      std::printf("  within 3 sigma      %10.1f %% of epochs (mean NEES %.2f, 2 if consistent)\n",
+                  100.0 * e.within_3sigma, e.mean_nees);
+  }
+  return 0;
+}
+
+const bool registered = cli::register_command(
+    20, "run", "Navigate a dataset with one IMU configuration and write the trajectory",
+    [](CLI::App& sub) {
+      auto a = std::make_shared<RunArgs>();
+      sub.add_option("config", a->config_file, "Run configuration (YAML; see docs/run-config.md)");
+      sub.add_option("--manifest,-m", a->manifest, "Dataset manifest (overrides the config's)");
+      sub.add_option("--configuration,-c", a->configuration,
+                     "single | dual-wheel | body-wheel | triple (default: single)");
+      sub.add_option("--chips", a->chips, "Chip per IMU, e.g. C1,C4 (default: the first of each)");
+      sub.add_option("--modules", a->modules, "Explicit module names (instead of a configuration)");
+      sub.add_option("--out,-o", a->out, "Output directory");
+      sub.add_option("--formats", a->formats, "Trajectory formats: csv,tum,kml (default: all)");
+      sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
+      sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
+      sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
+      sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
+      sub.add_option("--output-interval", a->output_interval, "Output interval [s]; 0 = every epoch");
+      sub.add_flag("--force,-f", a->force, "Overwrite existing results");
+      sub.add_flag("--quiet,-q", a->quiet, "No progress line and no option listing");
+      return [a]() { return run(*a); };
+    });
+}  // namespace

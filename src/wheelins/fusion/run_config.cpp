@@ -1,0 +1,166 @@
+#include "wheelins/fusion/run_config.hpp"
+
+#include "wheelins/fusion/presets.hpp"
+#include "wheelins/io/yaml_reader.hpp"
+
+namespace wheelins {
+namespace fs = std::filesystem;
+
+SpeedSharing speed_sharing_from_name(const std::string& name) {
+  if (name == "mean") return SpeedSharing::kMean;
+  if (name == "own") return SpeedSharing::kOwn;
+  throw InputError("wheel speed sharing '" + name + "': expected mean or own");
+}
+
+RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
+  const YamlReader y(file, warn);
+  const YAML::Node& root = y.root();
+  y.check_keys(root, "", {"dataset", "configuration", "chips", "modules", "output", "duration_s",
+                          "filter", "fusion"});
+  RunConfig c;
+  const fs::path base = file.parent_path();
+  auto rel = [&](const std::string& p) { return fs::path(p).is_absolute() ? fs::path(p) : base / p; };
+  c.manifest = rel(y.text(y.required(root, "", "dataset"), "dataset"));
+  if (auto v = y.get(root, "configuration"); v.IsDefined()) {
+    c.configuration = y.text(v, "configuration");
+    bool known = c.configuration == "single-right";
+    for (const auto& n : configuration_names()) known = known || n == c.configuration;
+    if (!known) y.fail("configuration", "unknown configuration '" + c.configuration + "'", &v);
+  }
+  if (auto v = y.get(root, "chips"); v.IsDefined()) c.chips = y.text_list(v, "chips");
+  if (auto v = y.get(root, "modules"); v.IsDefined()) c.modules = y.text_list(v, "modules");
+  if (auto v = y.get(root, "duration_s"); v.IsDefined()) {
+    c.max_duration = y.number(v, "duration_s");
+    y.positive(c.max_duration, "duration_s", v);
+  }
+
+  if (auto out = y.get(root, "output"); out.IsDefined()) {
+    y.require_map(out, "output");
+    y.check_keys(out, "output", {"dir", "formats", "interval_s", "overwrite", "subsystems"});
+    if (auto v = y.get(out, "dir"); v.IsDefined()) c.output_dir = rel(y.text(v, "output.dir"));
+    if (auto v = y.get(out, "formats"); v.IsDefined()) {
+      c.formats.clear();
+      for (const auto& f : y.text_list(v, "output.formats")) {
+        if (f != "csv" && f != "tum" && f != "kml")
+          y.fail("output.formats", "unknown format '" + f + "' (csv, tum or kml)", &v);
+        c.formats.push_back(trajectory_format_from_name(f));
+      }
+    }
+    if (auto v = y.get(out, "interval_s"); v.IsDefined()) {
+      c.nav.output_interval = y.number(v, "output.interval_s");
+      if (c.nav.output_interval < 0) y.fail("output.interval_s", "must be >= 0", &v);
+    }
+    if (auto v = y.get(out, "overwrite"); v.IsDefined()) c.overwrite = y.boolean(v, "output.overwrite");
+    if (auto v = y.get(out, "subsystems"); v.IsDefined())
+      c.write_subsystems = y.boolean(v, "output.subsystems");
+  }
+
+  if (auto f = y.get(root, "filter"); f.IsDefined()) {
+    y.require_map(f, "filter");
+    y.check_keys(f, "filter",
+                 {"mechanization", "earth_rotation", "velocity_update_hz", "speed_window_s",
+                  "wheel_velocity_std_m_s", "body_velocity_std_m_s", "velocity_gate",
+                  "initial_std"});
+    if (auto v = y.get(f, "mechanization"); v.IsDefined())
+      c.nav.mechanization = y.choice<MechanizationOptions::Method>(
+          v, "filter.mechanization",
+          {{"rotation-exact", MechanizationOptions::Method::kRotationExact},
+           {"classic", MechanizationOptions::Method::kClassicTwoSample}});
+    if (auto v = y.get(f, "earth_rotation"); v.IsDefined())
+      c.earth_rotation = y.choice<std::string>(v, "filter.earth_rotation",
+                                               {{"auto", "auto"}, {"true", "true"}, {"false", "false"}});
+    if (auto v = y.get(f, "velocity_update_hz"); v.IsDefined()) {
+      const double hz = y.number(v, "filter.velocity_update_hz");
+      y.positive(hz, "filter.velocity_update_hz", v);
+      c.nav.wheel.velocity_update_interval = 1.0 / hz;
+    }
+    if (auto v = y.get(f, "speed_window_s"); v.IsDefined()) {
+      c.nav.wheel.speed_window = y.number(v, "filter.speed_window_s");
+      y.positive(c.nav.wheel.speed_window, "filter.speed_window_s", v);
+    }
+    auto stds = [&](const char* key, Vec3& out) {
+      if (auto v = y.get(f, key); v.IsDefined()) {
+        const std::string path = std::string("filter.") + key;
+        out = y.vec3(v, path);
+        for (int i = 0; i < 3; ++i) y.positive(out[i], path, v);
+      }
+    };
+    stds("wheel_velocity_std_m_s", c.nav.wheel.velocity_std);
+    stds("body_velocity_std_m_s", c.nav.body.velocity_std);
+    if (auto v = y.get(f, "velocity_gate"); v.IsDefined()) {
+      c.nav.wheel.gate = c.nav.body.gate = y.number(v, "filter.velocity_gate");
+      if (c.nav.wheel.gate < 0) y.fail("filter.velocity_gate", "must be >= 0 (0 = off)", &v);
+    }
+    if (auto s = y.get(f, "initial_std"); s.IsDefined()) {
+      y.require_map(s, "filter.initial_std");
+      y.check_keys(s, "filter.initial_std",
+                   {"position_m", "velocity_m_s", "roll_pitch_deg", "heading_deg"});
+      InitialUncertainty& u = c.nav.wheel.init;
+      auto one = [&](const char* key, double& out, double factor) {
+        if (auto v = y.get(s, key); v.IsDefined()) {
+          const std::string path = std::string("filter.initial_std.") + key;
+          out = y.number(v, path) * factor;
+          y.positive(out, path, v);
+        }
+      };
+      one("position_m", u.position, 1.0);
+      one("velocity_m_s", u.velocity, 1.0);
+      one("roll_pitch_deg", u.roll_pitch, kDeg);
+      one("heading_deg", u.heading, kDeg);
+      c.nav.body.init = u;
+    }
+  }
+
+  if (auto f = y.get(root, "fusion"); f.IsDefined()) {
+    y.require_map(f, "fusion");
+    y.check_keys(f, "fusion", {"speed", "share_level", "position_constraint", "position_update_hz",
+                               "position_std_m", "position_gate", "weights", "centralized"});
+    FusionOptions& o = c.nav.fusion;
+    if (auto v = y.get(f, "speed"); v.IsDefined())
+      o.speed = y.choice<SpeedSharing>(v, "fusion.speed",
+                                       {{"mean", SpeedSharing::kMean}, {"own", SpeedSharing::kOwn}});
+    if (auto v = y.get(f, "share_level"); v.IsDefined()) o.share_level = y.boolean(v, "fusion.share_level");
+    if (auto v = y.get(f, "position_constraint"); v.IsDefined())
+      o.position_constraint = y.boolean(v, "fusion.position_constraint");
+    if (auto v = y.get(f, "position_update_hz"); v.IsDefined()) {
+      const double hz = y.number(v, "fusion.position_update_hz");
+      y.positive(hz, "fusion.position_update_hz", v);
+      o.position_update_interval = 1.0 / hz;
+    }
+    if (auto v = y.get(f, "position_std_m"); v.IsDefined()) {
+      o.position_std = y.number(v, "fusion.position_std_m");
+      y.positive(o.position_std, "fusion.position_std_m", v);
+    }
+    if (auto v = y.get(f, "position_gate"); v.IsDefined()) {
+      o.position_gate = y.number(v, "fusion.position_gate");
+      if (o.position_gate < 0) y.fail("fusion.position_gate", "must be >= 0 (0 = off)", &v);
+    }
+    if (auto v = y.get(f, "weights"); v.IsDefined()) o.weights = y.number_list(v, "fusion.weights");
+    if (auto v = y.get(f, "centralized"); v.IsDefined()) o.centralized = y.boolean(v, "fusion.centralized");
+  }
+  return c;
+}
+
+RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn) {
+  RunRequest r;
+  r.manifest = load_manifest(cfg.manifest, warn);
+  r.modules = cfg.modules.empty() ? configuration_modules(r.manifest, cfg.configuration, cfg.chips)
+                                  : cfg.modules;
+  r.nav = cfg.nav;
+  r.nav.earth_rotation =
+      cfg.earth_rotation == "auto" ? r.manifest.earth_rotation : cfg.earth_rotation == "true";
+  r.output_dir = cfg.output_dir;
+  if (r.output_dir.empty()) {
+    std::string name = cfg.modules.empty() ? cfg.configuration : std::string("modules");
+    for (const auto& m : r.modules) name += "-" + m;
+    r.output_dir = fs::path("results") / name;
+  }
+  r.formats = cfg.formats;
+  r.overwrite = cfg.overwrite;
+  r.write_subsystems = cfg.write_subsystems;
+  r.max_duration = cfg.max_duration;
+  r.warn = warn;
+  return r;
+}
+
+}  // namespace wheelins

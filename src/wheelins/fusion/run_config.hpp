@@ -1,0 +1,37 @@
+// The run configuration: which dataset, which IMUs, the filter settings and the
+// outputs. YAML in human units (docs/run-config.md), converted once here; every
+// setting has a default except the dataset.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "wheelins/fusion/run.hpp"
+
+namespace wheelins {
+
+struct RunConfig {
+  std::filesystem::path manifest;          ///< dataset manifest
+  std::string configuration = "single";    ///< see configuration_names()
+  std::vector<std::string> chips;          ///< one per IMU of the configuration
+  std::vector<std::string> modules;        ///< explicit modules (overrides configuration)
+  std::filesystem::path output_dir;        ///< default: results/<configuration>[-chips]
+  std::vector<TrajectoryFormat> formats{TrajectoryFormat::kCsv, TrajectoryFormat::kTum,
+                                        TrajectoryFormat::kKml};
+  bool overwrite = false;
+  bool write_subsystems = true;
+  double max_duration = 0.0;
+  std::string earth_rotation = "auto";     ///< auto (from the manifest) | true | false
+  NavigatorOptions nav;
+};
+
+/// Reads a run configuration; relative paths resolve against the file's directory.
+RunConfig load_run_config(const std::filesystem::path& file, const WarningSink& warn);
+
+SpeedSharing speed_sharing_from_name(const std::string& name);
+
+/// Loads the manifest, resolves the modules and fills a RunRequest.
+RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn);
+
+}  // namespace wheelins

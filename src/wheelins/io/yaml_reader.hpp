@@ -1,0 +1,66 @@
+// Reading YAML configuration with messages a user can act on: every error names
+// the file, the key path (e.g. `filter.velocity_std_m_s[1]`) and the line; unknown
+// keys are warnings naming the closest known key. Values are converted to SI by
+// the caller's factor at the one place they are read.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "wheelins/io/diagnostics.hpp"
+#include "wheelins/math/rotation.hpp"
+
+namespace wheelins {
+
+class YamlReader {
+ public:
+  /// Parses `file` (InputError if missing, a directory, unreadable, malformed or empty).
+  YamlReader(const std::filesystem::path& file, WarningSink warn);
+
+  const YAML::Node& root() const { return root_; }
+  const std::filesystem::path& file() const { return file_; }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what,
+                         const YAML::Node* at = nullptr) const;
+  void require_map(const YAML::Node& n, const std::string& path) const;
+  /// Warns about keys not in `known` (naming the closest) and rejects duplicates.
+  void check_keys(const YAML::Node& map, const std::string& path,
+                  const std::vector<std::string>& known) const;
+  /// The value at `key`, or an undefined node if absent or empty.
+  static YAML::Node get(const YAML::Node& map, const std::string& key);
+  YAML::Node required(const YAML::Node& map, const std::string& path, const std::string& key) const;
+
+  double number(const YAML::Node& v, const std::string& path) const;
+  std::string text(const YAML::Node& v, const std::string& path) const;
+  bool boolean(const YAML::Node& v, const std::string& path) const;
+  Vec3 vec3(const YAML::Node& v, const std::string& path, double factor = 1.0) const;
+  std::vector<std::string> text_list(const YAML::Node& v, const std::string& path) const;
+  std::vector<double> number_list(const YAML::Node& v, const std::string& path) const;
+  void positive(double x, const std::string& path, const YAML::Node& at) const;
+
+  template <class E>
+  E choice(const YAML::Node& v, const std::string& path,
+           const std::vector<std::pair<std::string, E>>& options) const {
+    if (v.IsScalar())
+      for (const auto& [name, value] : options)
+        if (v.Scalar() == name) return value;
+    std::string list;
+    for (const auto& o : options) list += (list.empty() ? "" : " or ") + o.first;
+    fail(path, "expected " + list + ", got " + describe(v), &v);
+  }
+
+  static std::string join(const std::string& path, const std::string& key);
+  static std::string index_path(const std::string& path, std::size_t i);
+  static std::string describe(const YAML::Node& n);
+
+ private:
+  std::filesystem::path file_;
+  WarningSink warn_;
+  YAML::Node root_;
+};
+
+}  // namespace wheelins
