@@ -1,0 +1,116 @@
+// Run configuration and configuration presets: values land in SI, bad values are
+// errors naming the file, key and line, unknown keys are warnings naming the closest key.
+#include <gtest/gtest.h>
+
+#include "io_test_util.hpp"
+#include "wheelins/fusion/presets.hpp"
+#include "wheelins/fusion/run_config.hpp"
+
+using namespace wheelins;
+using iotest::error_of;
+using iotest::ScratchDir;
+using iotest::write_text;
+
+namespace {
+Manifest three_groups() {
+  Manifest m;
+  m.path = "/data/m.yaml";
+  for (const char* side : {"left", "right"})
+    for (const char* chip : {"C1", "C2"}) {
+      ModuleSpec s;
+      s.name = std::string(side) + "-" + chip;
+      s.kind = ModuleKind::kWheel;
+      s.chip = chip;
+      s.p_inV = Vec3(0, std::string(side) == "left" ? -0.165 : 0.165, 0);
+      s.wheel_radius = 0.1;
+      m.modules.push_back(s);
+    }
+  for (const char* chip : {"C1", "C4"}) {
+    ModuleSpec s;
+    s.name = std::string("body-") + chip;
+    s.kind = ModuleKind::kBody;
+    s.chip = chip;
+    m.modules.push_back(s);
+  }
+  return m;
+}
+}  // namespace
+
+TEST(FusionPresets, ResolveByGroupAndChip) {
+  const Manifest m = three_groups();
+  EXPECT_EQ(configuration_modules(m, "single", {}), std::vector<std::string>{"left-C1"});
+  EXPECT_EQ(configuration_modules(m, "dual-wheel", {"C2", "C1"}),
+            (std::vector<std::string>{"left-C2", "right-C1"}));
+  EXPECT_EQ(configuration_modules(m, "body-wheel", {"C1", "C4"}),
+            (std::vector<std::string>{"left-C1", "body-C4"}));
+  EXPECT_EQ(configuration_modules(m, "triple", {}),
+            (std::vector<std::string>{"left-C1", "right-C1", "body-C1"}));
+  EXPECT_NE(error_of([&] { configuration_modules(m, "triple", {"C1", "C2"}); }).find("takes 3 chips"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { configuration_modules(m, "dual-wheel", {"C1", "C9"}); }).find("chip 'C9'"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { configuration_modules(m, "quad", {}); }).find("unknown configuration"),
+            std::string::npos);
+}
+
+TEST(FusionRunConfig, LoadsHumanUnitsIntoSi) {
+  ScratchDir dir;
+  write_text(dir / "run.yaml", R"(dataset: data/manifest.yaml
+configuration: triple
+chips: [C1, C2, C4]
+output: {dir: out/t, formats: [csv], interval_s: 0.1, overwrite: true}
+filter:
+  velocity_update_hz: 4
+  wheel_velocity_std_m_s: [0.05, 0.03, 0.03]
+  initial_std: {heading_deg: 0.5}
+fusion: {speed: own, position_update_hz: 2, position_std_m: 0.3, centralized: true}
+)");
+  std::vector<std::string> warnings;
+  const RunConfig c = load_run_config(dir / "run.yaml", [&](const std::string& w) { warnings.push_back(w); });
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(c.manifest, dir / "data/manifest.yaml");
+  EXPECT_EQ(c.configuration, "triple");
+  EXPECT_EQ(c.chips.size(), 3u);
+  EXPECT_EQ(c.output_dir, dir / "out/t");
+  EXPECT_TRUE(c.overwrite);
+  EXPECT_DOUBLE_EQ(c.nav.output_interval, 0.1);
+  EXPECT_DOUBLE_EQ(c.nav.wheel.velocity_update_interval, 0.25);
+  EXPECT_DOUBLE_EQ(c.nav.wheel.velocity_std.x(), 0.05);
+  EXPECT_NEAR(c.nav.wheel.init.heading, 0.5 * kDeg, 1e-15);
+  EXPECT_EQ(c.nav.fusion.speed, SpeedSharing::kOwn);
+  EXPECT_DOUBLE_EQ(c.nav.fusion.position_update_interval, 0.5);
+  EXPECT_DOUBLE_EQ(c.nav.fusion.position_std, 0.3);
+  EXPECT_TRUE(c.nav.fusion.centralized);
+}
+
+TEST(FusionRunConfig, BadValuesNameTheKeyAndLine) {
+  ScratchDir dir;
+  auto load = [&](const std::string& text) {
+    write_text(dir / "run.yaml", text);
+    return error_of([&] { load_run_config(dir / "run.yaml", {}); });
+  };
+  std::string e = load("configuration: single\n");
+  EXPECT_NE(e.find("run.yaml"), std::string::npos) << e;
+  EXPECT_NE(e.find("missing required key 'dataset'"), std::string::npos) << e;
+  e = load("dataset: m.yaml\nfilter:\n  velocity_update_hz: fast\n");
+  EXPECT_NE(e.find("filter.velocity_update_hz: expected a number, got 'fast' (line 3)"),
+            std::string::npos) << e;
+  e = load("dataset: m.yaml\nfilter:\n  wheel_velocity_std_m_s: [0.03, -1, 0.02]\n");
+  EXPECT_NE(e.find("filter.wheel_velocity_std_m_s: must be > 0"), std::string::npos) << e;
+  e = load("dataset: m.yaml\nfusion: {speed: fastest}\n");
+  EXPECT_NE(e.find("fusion.speed: expected mean or own"), std::string::npos) << e;
+  e = load("dataset: [unclosed\n");
+  EXPECT_NE(e.find("malformed YAML"), std::string::npos) << e;
+  e = error_of([&] { load_run_config(dir / "missing.yaml", {}); });
+  EXPECT_NE(e.find("missing.yaml': file not found"), std::string::npos) << e;
+}
+
+TEST(FusionRunConfig, UnknownKeyWarnsWithClosestKnown) {
+  ScratchDir dir;
+  write_text(dir / "run.yaml", "dataset: m.yaml\nfusion:\n  centralised: true\n");
+  std::vector<std::string> warnings;
+  load_run_config(dir / "run.yaml", [&](const std::string& w) { warnings.push_back(w); });
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("fusion.centralised: unknown key ignored (line 3); did you mean 'centralized'?"),
+            std::string::npos) << warnings[0];
+}
