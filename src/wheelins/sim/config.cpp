@@ -1,0 +1,404 @@
+#include "wheelins/sim/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <sstream>
+
+#include "wheelins/nav/types.hpp"
+
+namespace wheelins::sim {
+namespace {
+
+/// A number in human units: si = x * mul / div (the same expression the defaults use).
+struct HumanUnit {
+  double mul = 1.0, div = 1.0;
+};
+constexpr HumanUnit kSi{1.0, 1.0};
+constexpr HumanUnit kDegU{kDeg, 1.0};
+constexpr HumanUnit kDegH{kDeg, 3600.0};
+constexpr HumanUnit kArw{kDeg, 60.0};
+constexpr HumanUnit kVrw{1.0, 60.0};
+constexpr HumanUnit kPpm{1.0, 1e6};
+constexpr HumanUnit kMgPerK{9.80665e-3, 1.0};
+
+/// Shortest decimal text x with x * mul / div == si exactly (falls back to 17 digits).
+std::string human(double si, HumanUnit u) {
+  const double h = si * u.div / u.mul;
+  char buf[64];
+  // Enough digits for the integer part, so 120 prints as "120", not "1.2e+02".
+  const int int_digits = std::abs(h) >= 1.0 && std::abs(h) < 1e17
+                             ? static_cast<int>(std::floor(std::log10(std::abs(h)))) + 1
+                             : 1;
+  for (int p = std::max(1, int_digits); p <= 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*g", p, h);
+    if (std::strtod(buf, nullptr) * u.mul / u.div == si) return buf;
+  }
+  double c = h;  // neighbours of the quotient
+  for (int i = 0; i < 4; ++i) {
+    for (double d : {std::nextafter(c, 1e300), std::nextafter(c, -1e300)}) {
+      std::snprintf(buf, sizeof buf, "%.17g", d);
+      if (std::strtod(buf, nullptr) * u.mul / u.div == si) return buf;
+    }
+    c = std::nextafter(c, 1e300);
+  }
+  std::snprintf(buf, sizeof buf, "%.17g", h);
+  return buf;
+}
+
+std::string vec_text(const Vec3& v, HumanUnit u) {
+  return "[" + human(v.x(), u) + ", " + human(v.y(), u) + ", " + human(v.z(), u) + "]";
+}
+
+double get_double(const YAML::Node& n, const std::string& where) {
+  try {
+    return n.as<double>();
+  } catch (const YAML::Exception&) {
+    throw InputError(where + ": expected a number");
+  }
+}
+Vec3 get_vec(const YAML::Node& n, const std::string& where, HumanUnit u) {
+  if (!n.IsSequence() || n.size() != 3) throw InputError(where + ": expected [x, y, z]");
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) v[i] = get_double(n[i], where) * u.mul / u.div;
+  return v;
+}
+
+struct ErrorKey {
+  const char* key;
+  double ErrorParams::*member;
+  HumanUnit unit;
+};
+const ErrorKey kErrorKeys[] = {
+    {"gyro_bias_deg_h", &ErrorParams::gyro_bias, kDegH},
+    {"gyro_gm_sigma_deg_h", &ErrorParams::gyro_gm_sigma, kDegH},
+    {"gyro_gm_tau_s", &ErrorParams::gyro_gm_tau, kSi},
+    {"gyro_arw_deg_sqrt_h", &ErrorParams::gyro_arw, kArw},
+    {"gyro_sf_ppm", &ErrorParams::gyro_sf, kPpm},
+    {"gyro_misalignment_deg", &ErrorParams::gyro_misalign, kDegU},
+    {"gyro_lsb_deg_s", &ErrorParams::gyro_lsb, kDegU},
+    {"gyro_range_deg_s", &ErrorParams::gyro_range, kDegU},
+    {"gyro_tempco_deg_h_per_K", &ErrorParams::gyro_tempco, kDegH},
+    {"accel_bias_m_s2", &ErrorParams::accel_bias, kSi},
+    {"accel_gm_sigma_m_s2", &ErrorParams::accel_gm_sigma, kSi},
+    {"accel_gm_tau_s", &ErrorParams::accel_gm_tau, kSi},
+    {"accel_vrw_m_s_sqrt_h", &ErrorParams::accel_vrw, kVrw},
+    {"accel_sf_ppm", &ErrorParams::accel_sf, kPpm},
+    {"accel_misalignment_deg", &ErrorParams::accel_misalign, kDegU},
+    {"accel_lsb_m_s2", &ErrorParams::accel_lsb, kSi},
+    {"accel_range_m_s2", &ErrorParams::accel_range, kSi},
+    {"accel_tempco_mg_per_K", &ErrorParams::accel_tempco, kMgPerK},
+    {"temperature_rise_K", &ErrorParams::temp_rise, kSi},
+    {"temperature_tau_s", &ErrorParams::temp_tau, kSi},
+    {"radius_rel", &ErrorParams::radius_rel, kSi},
+    {"slip_per_m_s2", &ErrorParams::slip_coeff, kSi},
+    {"skid_s", &ErrorParams::skid_coeff, kSi},
+    {"time_offset_s", &ErrorParams::time_offset, kSi},
+    {"calibration_lever_arm_m", &ErrorParams::cal_lever_arm, kSi},
+    {"calibration_mounting_deg", &ErrorParams::cal_mounting, kDegU},
+    {"calibration_position_m", &ErrorParams::cal_position, kSi},
+    {"calibration_radius_rel", &ErrorParams::cal_radius_rel, kSi},
+};
+struct ErrorVecKey {
+  const char* key;
+  Vec3 ErrorParams::*member;
+  HumanUnit unit;
+};
+const ErrorVecKey kErrorVecKeys[] = {
+    {"vibration_body_accel_rms_m_s2", &ErrorParams::vib_body_accel, kSi},
+    {"vibration_body_rate_rms_deg_s", &ErrorParams::vib_body_rate, kDegU},
+    {"vibration_wheel_accel_rms_m_s2", &ErrorParams::vib_wheel_accel, kSi},
+    {"vibration_wheel_rate_rms_deg_s", &ErrorParams::vib_wheel_rate, kDegU},
+};
+
+void check_effect(const std::string& name) {
+  for (const auto& e : all_effects())
+    if (e == name) return;
+  std::string list;
+  for (const auto& e : all_effects()) list += (list.empty() ? "" : ", ") + e;
+  throw InputError("unknown effect '" + name + "' (known: " + list + ")");
+}
+
+}  // namespace
+
+std::set<std::string> profile_effects(const std::string& profile) {
+  const auto& all = all_effects();
+  if (profile == "ideal") return {};
+  if (profile == "datasheet") return {all.begin(), all.begin() + 11};
+  if (profile == "field") return {all.begin(), all.end()};
+  throw InputError("unknown profile '" + profile + "' (expected ideal, datasheet or field)");
+}
+
+VehicleConfig VehicleConfig::preset_named(const std::string& name) {
+  VehicleConfig v;
+  v.preset = name;
+  v.left.group = "left-wheel";
+  v.right.group = "right-wheel";
+  v.body.group = "body";
+  v.body.wheel = false;
+  if (name == "robot") {
+    // Pioneer 3DX-like: the Wheel-INS dataset's radius, lever arm and rate.
+    v.wheel_radius = 0.097;
+    v.track = 0.33;
+    v.left.lever_arm_inB = Vec3(0.015, -0.004, 0.006);
+    v.right.lever_arm_inB = Vec3(-0.015, 0.005, 0.005);
+    v.left.mounting_rpy = Vec3(0.0, 0.6, -0.8) * kDeg;
+    v.right.mounting_rpy = Vec3(0.0, -0.5, 0.4) * kDeg;
+    v.body.p_inV = Vec3(0.12, 0.03, -0.22);
+    v.body.mounting_rpy = Vec3(0.4, -0.6, 1.2) * kDeg;
+  } else if (name == "car") {
+    v.wheel_radius = 0.35;
+    v.track = 1.6;
+    v.left.lever_arm_inB = Vec3(0.02, 0.004, -0.003);
+    v.right.lever_arm_inB = Vec3(-0.02, -0.003, 0.004);
+    v.left.mounting_rpy = Vec3(0.0, 0.5, -0.7) * kDeg;
+    v.right.mounting_rpy = Vec3(0.0, -0.6, 0.3) * kDeg;
+    v.body.p_inV = Vec3(1.3, 0.1, -0.5);
+    v.body.mounting_rpy = Vec3(0.5, -0.3, 0.8) * kDeg;
+  } else {
+    throw InputError("unknown vehicle preset '" + name + "' (expected robot or car)");
+  }
+  v.left.p_inV = Vec3(0.0, -0.5 * v.track, 0.0);
+  v.right.p_inV = Vec3(0.0, 0.5 * v.track, 0.0);
+  return v;
+}
+
+void SimConfig::set_profile(const std::string& name) {
+  effects = profile_effects(name);
+  profile = name;
+  errors = ErrorParams{};
+  if (name == "field") errors.gyro_sf = 3000e-6;
+}
+
+void SimConfig::disable(const std::vector<std::string>& names) {
+  for (const auto& n : names) {
+    check_effect(n);
+    effects.erase(n);
+  }
+}
+
+void SimConfig::only(const std::vector<std::string>& names) {
+  effects.clear();
+  for (const auto& n : names) {
+    check_effect(n);
+    effects.insert(n);
+  }
+}
+
+void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
+  if (!node.IsMap()) throw InputError(where + ": expected a map of settings");
+  static const std::set<std::string> known = {
+      "seed", "profile", "effects", "scenario", "speed_file", "duration_s", "rate_hz", "chips",
+      "gps_week", "earth_rotation", "start_time_s", "origin", "static_s", "laps", "speed_m_s",
+      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "vehicle", "errors"};
+  for (const auto& kv : node) {
+    const auto k = kv.first.as<std::string>();
+    if (!known.count(k)) throw InputError(where + ": unknown key '" + k + "'");
+  }
+  auto key = [&](const std::string& k) { return where + ": " + k; };
+  try {
+    // Profile and preset first: they reset what they own.
+    if (node["profile"]) set_profile(node["profile"].as<std::string>());
+    if (node["vehicle"] && node["vehicle"]["preset"])
+      vehicle = VehicleConfig::preset_named(node["vehicle"]["preset"].as<std::string>());
+    if (node["effects"]) {
+      std::vector<std::string> list;
+      for (const auto& e : node["effects"]) list.push_back(e.as<std::string>());
+      only(list);
+    }
+    if (node["seed"]) seed = node["seed"].as<std::uint64_t>();
+    if (node["scenario"]) scenario = node["scenario"].as<std::string>();
+    if (node["speed_file"]) {
+      if (node["speed_file"].IsNull()) speed_file.reset();
+      else speed_file = node["speed_file"].as<std::string>();
+    }
+    if (node["duration_s"]) {
+      if (node["duration_s"].IsNull()) duration.reset();
+      else duration = get_double(node["duration_s"], key("duration_s"));
+    }
+    if (node["rate_hz"]) rate_hz = get_double(node["rate_hz"], key("rate_hz"));
+    if (node["chips"]) chips = node["chips"].as<int>();
+    if (node["gps_week"]) gps_week = get_double(node["gps_week"], key("gps_week"));
+    if (node["earth_rotation"]) earth_rotation = node["earth_rotation"].as<bool>();
+    if (node["start_time_s"]) {
+      if (node["start_time_s"].IsNull()) start_time.reset();
+      else start_time = get_double(node["start_time_s"], key("start_time_s"));
+    }
+    if (node["origin"]) {
+      const auto& o = node["origin"];
+      if (o.IsNull()) {
+        origin.reset();
+      } else {
+        earth::Geodetic g;
+        g.lat = get_double(o["lat_deg"], key("origin.lat_deg")) * kDeg;
+        g.lon = get_double(o["lon_deg"], key("origin.lon_deg")) * kDeg;
+        g.h = o["h_m"] ? get_double(o["h_m"], key("origin.h_m")) : 0.0;
+        origin = g;
+      }
+    }
+    if (node["static_s"]) static_duration = get_double(node["static_s"], key("static_s"));
+    if (node["laps"]) laps = node["laps"].as<int>();
+    if (node["stops"]) stops = node["stops"].as<bool>();
+    auto opt_double = [&](const char* k, std::optional<double>& dst) {
+      if (!node[k]) return;
+      if (node[k].IsNull()) dst.reset();
+      else dst = get_double(node[k], key(k));
+    };
+    opt_double("speed_m_s", speed);
+    opt_double("loop_scale", loop_scale);
+    opt_double("path_sigma_m", path_sigma);
+    opt_double("speed_sigma_s", speed_sigma);
+    if (node["terrain_slope_deg"])
+      terrain_slope_deg = get_double(node["terrain_slope_deg"], key("terrain_slope_deg"));
+    if (const auto& v = node["vehicle"]) {
+      static const std::set<std::string> vk = {"preset", "wheel_radius_m", "track_m", "left-wheel",
+                                               "right-wheel", "body"};
+      for (const auto& kv : v)
+        if (!vk.count(kv.first.as<std::string>()))
+          throw InputError(key("vehicle") + ": unknown key '" + kv.first.as<std::string>() + "'");
+      if (v["wheel_radius_m"]) vehicle.wheel_radius = get_double(v["wheel_radius_m"], key("vehicle.wheel_radius_m"));
+      if (v["track_m"]) {
+        vehicle.track = get_double(v["track_m"], key("vehicle.track_m"));
+        vehicle.left.p_inV.y() = -0.5 * vehicle.track;
+        vehicle.right.p_inV.y() = 0.5 * vehicle.track;
+      }
+      for (ModuleGeometry* m : {&vehicle.left, &vehicle.right, &vehicle.body}) {
+        const auto& mn = v[m->group];
+        if (!mn) continue;
+        const std::string w = key("vehicle." + m->group);
+        for (const auto& kv : mn) {
+          const auto k = kv.first.as<std::string>();
+          if (k != "position_m" && k != "mounting_deg" && !(m->wheel && k == "lever_arm_m"))
+            throw InputError(w + ": unknown key '" + k + "'");
+        }
+        if (mn["position_m"]) m->p_inV = get_vec(mn["position_m"], w + ".position_m", kSi);
+        if (mn["lever_arm_m"]) m->lever_arm_inB = get_vec(mn["lever_arm_m"], w + ".lever_arm_m", kSi);
+        if (mn["mounting_deg"]) m->mounting_rpy = get_vec(mn["mounting_deg"], w + ".mounting_deg", kDegU);
+      }
+    }
+    if (const auto& e = node["errors"]) {
+      for (const auto& kv : e) {
+        const auto k = kv.first.as<std::string>();
+        bool found = false;
+        for (const auto& ek : kErrorKeys)
+          if (k == ek.key) {
+            errors.*ek.member = get_double(kv.second, key("errors." + k)) * ek.unit.mul / ek.unit.div;
+            found = true;
+          }
+        for (const auto& ek : kErrorVecKeys)
+          if (k == ek.key) {
+            errors.*ek.member = get_vec(kv.second, key("errors." + k), ek.unit);
+            found = true;
+          }
+        if (k == "vibration_body_band_hz" || k == "vibration_wheel_band_hz") {
+          double* band = k == "vibration_body_band_hz" ? errors.vib_body_band : errors.vib_wheel_band;
+          if (!kv.second.IsSequence() || kv.second.size() != 2)
+            throw InputError(key("errors." + k) + ": expected [low, high]");
+          band[0] = get_double(kv.second[0], key("errors." + k));
+          band[1] = get_double(kv.second[1], key("errors." + k));
+          found = true;
+        }
+        if (!found) throw InputError(key("errors") + ": unknown key '" + k + "'");
+      }
+    }
+  } catch (const YAML::Exception& ex) {
+    throw InputError(where + ": " + ex.what());
+  }
+  if (!(rate_hz > 0.0) || rate_hz > 10000.0) throw InputError(key("rate_hz") + ": must be in (0, 10000]");
+  if (chips < 1 || chips > 16) throw InputError(key("chips") + ": must be 1..16");
+  if (!(vehicle.wheel_radius > 0.0)) throw InputError(key("vehicle.wheel_radius_m") + ": must be positive");
+  if (duration && !(*duration > 0.0)) throw InputError(key("duration_s") + ": must be positive");
+  if (speed && !(*speed > 0.0)) throw InputError(key("speed_m_s") + ": must be positive");
+  if (laps < 1) throw InputError(key("laps") + ": must be at least 1");
+}
+
+void SimConfig::apply_setting(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set '" + assignment + "': expected key.path=value");
+  const std::string path = assignment.substr(0, eq);
+  YAML::Node value;
+  try {
+    value = YAML::Load(assignment.substr(eq + 1));
+  } catch (const YAML::Exception& ex) {
+    throw InputError("--set '" + assignment + "': " + ex.what());
+  }
+  // Build {a: {b: {c: value}}}.
+  std::vector<std::string> parts;
+  std::size_t pos = 0;
+  while (true) {
+    const auto dot = path.find('.', pos);
+    parts.push_back(path.substr(pos, dot == std::string::npos ? std::string::npos : dot - pos));
+    if (dot == std::string::npos) break;
+    pos = dot + 1;
+  }
+  YAML::Node node = value;
+  for (auto it = parts.rbegin(); it != parts.rend(); ++it) {
+    YAML::Node m(YAML::NodeType::Map);
+    m[*it] = node;
+    node = m;
+  }
+  apply_yaml(node, "--set " + path);
+}
+
+std::string SimConfig::to_yaml() const {
+  std::ostringstream o;
+  o << "# wheelins simulate: every setting of this dataset. Reproduce it with\n"
+       "#   wheelins simulate --config scenario.yaml --out DIR\n"
+       "# (relative paths are as given on the command line). Units in the key names.\n";
+  o << "seed: " << seed << "\n";
+  o << "profile: " << profile << "\n";
+  o << "effects: [";
+  bool first = true;
+  for (const auto& e : all_effects())
+    if (effects.count(e)) {
+      o << (first ? "" : ", ") << e;
+      first = false;
+    }
+  o << "]\n";
+  o << "scenario: \"" << scenario << "\"\n";
+  o << "speed_file: " << (speed_file ? "\"" + speed_file->string() + "\"" : std::string("null")) << "\n";
+  o << "duration_s: " << (duration ? human(*duration, kSi) : std::string("null")) << "\n";
+  o << "rate_hz: " << human(rate_hz, kSi) << "\n";
+  o << "chips: " << chips << "\n";
+  o << "gps_week: " << human(gps_week, kSi) << "\n";
+  o << "earth_rotation: " << (earth_rotation ? "true" : "false") << "\n";
+  o << "start_time_s: " << (start_time ? human(*start_time, kSi) : std::string("null")) << "\n";
+  if (origin)
+    o << "origin: {lat_deg: " << human(origin->lat, kDegU) << ", lon_deg: " << human(origin->lon, kDegU)
+      << ", h_m: " << human(origin->h, kSi) << "}\n";
+  else
+    o << "origin: null\n";
+  o << "static_s: " << human(static_duration, kSi) << "\n";
+  o << "laps: " << laps << "\n";
+  auto opt_text = [](const std::optional<double>& v) { return v ? human(*v, kSi) : std::string("null"); };
+  o << "speed_m_s: " << opt_text(speed) << "\n";
+  o << "loop_scale: " << opt_text(loop_scale) << "\n";
+  o << "stops: " << (stops ? "true" : "false") << "\n";
+  o << "path_sigma_m: " << (path_sigma ? human(*path_sigma, kSi) : std::string("null")) << "\n";
+  o << "speed_sigma_s: " << (speed_sigma ? human(*speed_sigma, kSi) : std::string("null")) << "\n";
+  o << "terrain_slope_deg: " << human(terrain_slope_deg, kSi) << "\n";
+  o << "vehicle:\n";
+  o << "  preset: " << vehicle.preset << "\n";
+  o << "  wheel_radius_m: " << human(vehicle.wheel_radius, kSi) << "\n";
+  o << "  track_m: " << human(vehicle.track, kSi) << "\n";
+  for (const ModuleGeometry* m : {&vehicle.left, &vehicle.right, &vehicle.body}) {
+    o << "  " << m->group << ":\n";
+    o << "    position_m: " << vec_text(m->p_inV, kSi) << "\n";
+    if (m->wheel) o << "    lever_arm_m: " << vec_text(m->lever_arm_inB, kSi) << "\n";
+    o << "    mounting_deg: " << vec_text(m->mounting_rpy, kDegU) << "\n";
+  }
+  o << "errors:\n";
+  for (const auto& ek : kErrorKeys) o << "  " << ek.key << ": " << human(errors.*ek.member, ek.unit) << "\n";
+  for (const auto& ek : kErrorVecKeys) o << "  " << ek.key << ": " << vec_text(errors.*ek.member, ek.unit) << "\n";
+  o << "  vibration_body_band_hz: [" << human(errors.vib_body_band[0], kSi) << ", "
+    << human(errors.vib_body_band[1], kSi) << "]\n";
+  o << "  vibration_wheel_band_hz: [" << human(errors.vib_wheel_band[0], kSi) << ", "
+    << human(errors.vib_wheel_band[1], kSi) << "]\n";
+  return o.str();
+}
+
+}  // namespace wheelins::sim
