@@ -228,17 +228,31 @@ struct JMat3 {
       for (int j = 0; j < 3; ++j) r.m[i][j] = m[i][0] * o.m[0][j] + m[i][1] * o.m[1][j] + m[i][2] * o.m[2][j];
     return r;
   }
-  JMat3 operator*(const Mat3& o) const { return *this * JMat3(o); }
+  JMat3 operator*(const Mat3& o) const {
+    JMat3 r;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r.m[i][j] = m[i][0] * o(0, j) + m[i][1] * o(1, j) + m[i][2] * o(2, j);
+    return r;
+  }
   JVec3<N> operator*(const JVec3<N>& x) const {
     JVec3<N> r;
     for (int i = 0; i < 3; ++i) r[i] = m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2];
     return r;
   }
-  JVec3<N> operator*(const Vec3& x) const { return *this * JVec3<N>(x); }
+  JVec3<N> operator*(const Vec3& x) const {
+    JVec3<N> r;
+    for (int i = 0; i < 3; ++i) r[i] = m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2];
+    return r;
+  }
 };
 
 template <int N>
-JMat3<N> operator*(const Mat3& a, const JMat3<N>& b) { return JMat3<N>(a) * b; }
+JMat3<N> operator*(const Mat3& a, const JMat3<N>& b) {
+  JMat3<N> r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a(i, 0) * b.m[0][j] + a(i, 1) * b.m[1][j] + a(i, 2) * b.m[2][j];
+  return r;
+}
 
 /// Elementary rotations with a jet angle (same convention as wheelins::rot_x etc.).
 template <int N>

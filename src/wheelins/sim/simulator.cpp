@@ -101,6 +101,58 @@ void Vibration::eval(double t, JV& disp, JV& rot) const {
   }
 }
 
+void Vibration::prepare(const double offsets[4], double h) {
+  step_h = h;
+  since_exact = -1;
+  for (int d = 0; d < 6; ++d) {
+    node_phasors[d].clear();
+    phase_state[d].clear();
+    for (const auto& c : dof[d]) phase_state[d].push_back({0.0, 0.0, std::cos(c.omega * h), std::sin(c.omega * h)});
+    for (const auto& c : dof[d]) {
+      std::array<double, 8> ph;
+      for (int i = 0; i < 4; ++i) {
+        ph[2 * i] = std::cos(c.omega * offsets[i]);
+        ph[2 * i + 1] = std::sin(c.omega * offsets[i]);
+      }
+      node_phasors[d].push_back(ph);
+    }
+  }
+}
+
+void Vibration::eval4(double t_mid, JV disp[4], JV rot[4]) {
+  const bool exact = since_exact < 0 || since_exact >= 255 ||
+                     std::abs(t_mid - last_mid - step_h) > 1e-9 * step_h;
+  since_exact = exact ? 0 : since_exact + 1;
+  last_mid = t_mid;
+  for (int d = 0; d < 6; ++d) {
+    J acc[4];
+    for (std::size_t k = 0; k < dof[d].size(); ++k) {
+      const Component& c = dof[d][k];
+      const auto& ph = node_phasors[d][k];
+      auto& st = phase_state[d][k];
+      if (exact) {
+        const double th = c.omega * t_mid + c.phase;
+        st[0] = std::sin(th);
+        st[1] = std::cos(th);
+      } else {
+        const double sn = st[0] * st[2] + st[1] * st[3];
+        st[1] = st[1] * st[2] - st[0] * st[3];
+        st[0] = sn;
+      }
+      const double s0 = st[0], c0 = st[1], w = c.omega, a = c.amplitude;
+      for (int i = 0; i < 4; ++i) {
+        const double s = s0 * ph[2 * i] + c0 * ph[2 * i + 1];  // sin(th + w off_i)
+        const double co = c0 * ph[2 * i] - s0 * ph[2 * i + 1];
+        acc[i].c[0] += a * s;
+        if constexpr (kOrder >= 1) acc[i].c[1] += a * w * co;
+        if constexpr (kOrder >= 2) acc[i].c[2] -= a * w * w * s / 2.0;
+        if constexpr (kOrder >= 3) acc[i].c[3] -= a * w * w * w * co / 6.0;
+      }
+    }
+    for (int i = 0; i < 4; ++i) (d < 3 ? disp[i][d] : rot[i][d - 3]) = acc[i];
+  }
+}
+
 Vibration Vibration::draw(Rng& rng, const Vec3& accel_rms, const Vec3& rate_rms, const double band[2],
                           int components) {
   Vibration v;
@@ -143,9 +195,12 @@ struct NodeResult {
 class GroupStepper {
  public:
   GroupStepper(const Simulation& sim, int g, double offset)
-      : sim_(sim), m_(sim.modules_[g]), offset_(offset), wheel_(m_.truth.wheel) {
+      : sim_(sim), m_(sim.modules_[g]), offset_(offset), wheel_(m_.truth.wheel),
+        vib_(m_.vibration), h_(1.0 / sim.cfg_.rate_hz) {
     C0_ = wheel_c0();
     C_sb_ = dcm_from_euler(m_.truth.mounting_rpy);
+    for (int i = 0; i < 4; ++i) node_offset_[i] = 0.5 * h_ * kGlX[i];
+    if (!vib_.empty()) vib_.prepare(node_offset_, h_);
     if (wheel_ && offset != 0.0) {
       // alpha is zero at the scenario start; integrate to the offset start.
       const double a = sim.start_time(), b = a + offset;
@@ -156,16 +211,19 @@ class GroupStepper {
     }
   }
 
-  /// Mean gyro / accel (sensor axes) over the stamped interval (t0, t1].
-  void step(double t0, double t1, Vec3& gyro, Vec3& accel) {
-    const double a = t0 + offset_, b = t1 + offset_;
-    const double h = b - a;
+  /// Mean gyro / accel (sensor axes) over the stamped interval (t1 - 1/rate, t1]. (The
+  /// nominal interval length is used: stamps t0 + k/rate differ from it by rounding only.)
+  void step(double t1, Vec3& gyro, Vec3& accel) {
+    const double h = h_;
+    const double mid = t1 + offset_ - 0.5 * h;
     JV p_o[4];
     JM C_v[4];
     J rate[4];
     double t[4];
+    JV disp[4], rot[4];
+    if (!vib_.empty()) vib_.eval4(mid, disp, rot);
     for (int i = 0; i < 4; ++i) {
-      t[i] = 0.5 * (a + b) + 0.5 * h * kGlX[i];
+      t[i] = mid + node_offset_[i];
       sim_.scenario_->evaluate(t[i], p_o[i], C_v[i]);
       if (wheel_) rate[i] = wheel_rate_jet(m_, p_o[i], C_v[i]);
     }
@@ -178,7 +236,8 @@ class GroupStepper {
         for (int j = 0; j < 4; ++j) ai += 0.5 * h * kLagrange.A[i][j] * rate[j].value();
         alpha = integrate(ai, rate[i]);
       }
-      const NodeResult r = node(t[i], p_o[i], C_v[i], alpha);
+      const NodeResult r = node(t[i], p_o[i], C_v[i], alpha, vib_.empty() ? nullptr : &disp[i],
+                                vib_.empty() ? nullptr : &rot[i]);
       gyro += 0.5 * kGlW[i] * r.gyro;
       accel += 0.5 * kGlW[i] * r.accel;
     }
@@ -200,29 +259,38 @@ class GroupStepper {
   }
 
   /// Position and attitude (sensor axes) jets of the IMU.
-  void imu_jets(double t, const JV& p_o, const JM& C_v, const J& alpha, JV& p, JM& C_s) const {
+  void imu_jets(double t, const JV& p_o, const JM& C_v, const J& alpha, JV& p, JM& C_s,
+                const JV* vib_disp = nullptr, const JV* vib_rot = nullptr) const {
     JV disp(Vec3::Zero()), rot(Vec3::Zero());
-    if (!m_.vibration.empty()) m_.vibration.eval(t, disp, rot);
+    if (vib_disp) {
+      disp = *vib_disp;
+      rot = *vib_rot;
+    } else if (!m_.vibration.empty()) {
+      m_.vibration.eval(t, disp, rot);
+    }
     const JV offset_v = JV(m_.truth.p_inV) + disp;
     if (wheel_) {
-      JM C_vib = m_.vibration.empty() ? JM(Mat3::Identity()) : jdcm_from_euler(rot[0], rot[1], rot[2]);
-      const JM C_b = C_v * C_vib * C0_ * jrot_x(-alpha);  // ideal wheel b-frame
+      const bool vib = vib_disp || !m_.vibration.empty();
+      const JM C_wheel = C0_ * jrot_x(-alpha);
+      const JM C_b = vib ? C_v * (jdcm_from_euler(rot[0], rot[1], rot[2]) * C_wheel)
+                         : C_v * C_wheel;  // ideal wheel b-frame
       C_s = C_b * C_sb_;
       p = p_o + C_v * offset_v - C_b * m_.truth.lever_arm_inB;
     } else {
-      if (m_.vibration.empty()) {
-        C_s = C_v * C_sb_;
+      if (vib_disp || !m_.vibration.empty()) {
+        C_s = C_v * (jdcm_from_euler(rot[0], rot[1], rot[2]) * C_sb_);
       } else {
-        C_s = C_v * jdcm_from_euler(rot[0], rot[1], rot[2]) * C_sb_;
+        C_s = C_v * C_sb_;
       }
       p = p_o + C_v * offset_v;
     }
   }
 
-  NodeResult node(double t, const JV& p_o, const JM& C_v, const J& alpha) const {
+  NodeResult node(double t, const JV& p_o, const JM& C_v, const J& alpha, const JV* disp,
+                  const JV* rot) const {
     JV p;
     JM C_s;
-    imu_jets(t, p_o, C_v, alpha, p, C_s);
+    imu_jets(t, p_o, C_v, alpha, p, C_s, disp, rot);
     const Mat3 C = C_s.value();
     const Vec3 v = p.deriv(1), acc = p.deriv(2);
     const Vec3 w = sim_.omega_ie_;
@@ -237,6 +305,9 @@ class GroupStepper {
   const ModuleModel& m_;
   double offset_;
   bool wheel_;
+  Vibration vib_;  // a copy with the node phasors of this stepper
+  double h_;
+  double node_offset_[4];
   Mat3 C0_, C_sb_;
   double alpha_ = 0.0;
 };
@@ -419,13 +490,12 @@ std::vector<ImuSample> Simulation::ideal_samples(int g, std::size_t count) const
   out.reserve(count);
   const double t0 = start_time();
   for (std::size_t k = 1; k <= count; ++k) {
-    const double a = t0 + static_cast<double>(k - 1) / cfg_.rate_hz;
     const double b = t0 + static_cast<double>(k) / cfg_.rate_hz;
     Vec3 gy, ac;
-    st.step(a, b, gy, ac);
+    st.step(b, gy, ac);
     ImuSample s;
     s.t = b;
-    s.dt = b - a;
+    s.dt = 1.0 / cfg_.rate_hz;
     s.dtheta = gy * s.dt;
     s.dvel = ac * s.dt;
     out.push_back(s);
@@ -684,10 +754,10 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
       }
       double row[7];
       for (std::uint64_t k = 1; k <= K; ++k) {
-        const double a = stamp(k - 1), b = stamp(k);
+        const double b = stamp(k);
         Vec3 w, f, wi, fi;
-        st.step(a, b, w, f);
-        if (ideal) ideal->step(a, b, wi, fi);
+        st.step(b, w, f);
+        if (ideal) ideal->step(b, wi, fi);
         else wi = w, fi = f;
         row[0] = b;
         for (int i = 0; i < 3; ++i) row[1 + i] = wi[i], row[4 + i] = fi[i];
