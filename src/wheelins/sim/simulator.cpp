@@ -185,6 +185,19 @@ J wheel_rate_jet(const ModuleModel& m, const JV& p_o, const JM& C_v) {
   return vf * (1.0 + m.slip_coeff * af) / m.radius;
 }
 
+/// Vibration gain from the speed of o (see ModuleModel::vib_cruise_speed).
+J vibration_gain(const ModuleModel& m, const JV& p_o) {
+  const JV v = p_o.dot();
+  const double v0 = 0.3 * m.vib_cruise_speed;
+  const J x = dot(v, v) / (v0 * v0);
+  const double xc = 1.0 / 0.09;  // x at the cruise speed
+  return x / (1.0 + x) * ((1.0 + xc) / xc);
+}
+
+void scale(JV& a, const J& g) {
+  for (int i = 0; i < 3; ++i) a[i] = a[i] * g;
+}
+
 struct NodeResult {
   Vec3 gyro, accel;
 };
@@ -226,6 +239,11 @@ class GroupStepper {
       t[i] = mid + node_offset_[i];
       sim_.scenario_->evaluate(t[i], p_o[i], C_v[i]);
       if (wheel_) rate[i] = wheel_rate_jet(m_, p_o[i], C_v[i]);
+      if (!vib_.empty()) {
+        const J gain = vibration_gain(m_, p_o[i]);
+        scale(disp[i], gain);
+        scale(rot[i], gain);
+      }
     }
     gyro.setZero();
     accel.setZero();
@@ -267,6 +285,9 @@ class GroupStepper {
       rot = *vib_rot;
     } else if (!m_.vibration.empty()) {
       m_.vibration.eval(t, disp, rot);
+      const J gain = vibration_gain(m_, p_o);
+      scale(disp, gain);
+      scale(rot, gain);
     }
     const JV offset_v = JV(m_.truth.p_inV) + disp;
     if (wheel_) {
@@ -315,6 +336,19 @@ class GroupStepper {
 // ---------------------------------------------------------------------------------------------
 // Simulation
 
+namespace {
+/// The typical (cruise) speed of a scenario: the mean speed while moving faster than 0.2 m/s.
+double cruise_speed_of(const Scenario& s) {
+  double sum = 0.0;
+  int n = 0;
+  for (double t = s.start_time(); t < s.end_time(); t += 1.0) {
+    const double v = s.state(t).v_inN.norm();
+    if (v > 0.2) sum += v, ++n;
+  }
+  return n > 0 ? sum / n : 1.0;
+}
+}  // namespace
+
 const char* Simulation::group_name(int g) {
   static const char* n[] = {"left-wheel", "right-wheel", "body"};
   return n[g];
@@ -356,6 +390,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     o.terrain = terrain;
     scenario_ = std::make_unique<PathScenario>(path_file_scenario_spec(cfg_.scenario, o, &speed_scale_));
   }
+  const double cruise = cruise_speed_of(*scenario_);
   end_ = scenario_->end_time();
   if (cfg_.duration) end_ = std::min(end_, scenario_->start_time() + *cfg_.duration);
   const earth::Geodetic org = scenario_->origin();
@@ -393,6 +428,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
       Vibration v = wheel ? Vibration::draw(r, e.vib_wheel_accel, e.vib_wheel_rate, e.vib_wheel_band)
                           : Vibration::draw(r, e.vib_body_accel, e.vib_body_rate, e.vib_body_band);
       if (cfg_.on("vibration")) m.vibration = std::move(v);
+      m.vib_cruise_speed = cruise;
     }
     {
       Rng r(cfg_.seed, gn + "/calibration");
@@ -607,6 +643,8 @@ std::string Simulation::errors_yaml() const {
       o << "    slip_per_m_s2: " << num(m.slip_coeff) << "\n";
     }
     o << "    time_offset_s: " << num(m.time_offset) << "  # a sample stamped t covers (t-dt+offset, t+offset]\n";
+    if (!m.vibration.empty())
+      o << "    vibration_cruise_speed_m_s: " << num(m.vib_cruise_speed) << "  # the vibration scales with speed\n";
     o << "    temperature_rise_K: " << num(m.temp_rise) << "  # tau " << num(e.temp_tau) << " s\n";
     o << "    position_v_m: {true: " << vec(m.truth.p_inV) << ", manifest: " << vec(m.manifest.p_inV) << "}\n";
     if (m.truth.wheel)

@@ -58,6 +58,10 @@ struct ModuleModel {
   double time_offset = 0.0;    ///< true clock offset: a sample stamped t covers (t-dt+off, t+off]
   double temp_rise = 0.0;      ///< [K]
   Vibration vibration;
+  /// The vibration scales with the speed v of o: gain = s(v) / s(v_cruise), s(v) = x / (1 + x),
+  /// x = (v / (0.3 v_cruise))^2: zero at rest, 1 at the cruise speed (a smooth function of the
+  /// motion, so the vibrating displacement still has exact derivatives).
+  double vib_cruise_speed = 1.4;
 };
 
 /// Error parameters drawn for one chip (SI units).
