@@ -384,7 +384,8 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     o.speed = cfg_.speed.value_or(car ? 6.0 : 1.4);
     if (cfg_.start_time) o.start_time = *cfg_.start_time;
     o.path_sigma = cfg_.path_sigma.value_or(car ? 3.0 : 0.7);
-    o.profile_sigma = cfg_.speed_sigma.value_or(0.5);
+    // An odometer profile is already smooth; a constant cruise speed needs the default's ramps.
+    o.profile_sigma = cfg_.speed_sigma.value_or(cfg_.speed_file ? 0.5 : (car ? 2.5 : 1.2));
     o.origin = cfg_.origin;
     o.skid_coeff = skid;
     o.terrain = terrain;
