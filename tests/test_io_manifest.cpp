@@ -378,3 +378,23 @@ TEST(IoManifest, DefaultsAndTypicalValuesAreWrittenAsPeopleWriteThem) {
     EXPECT_HAS(yaml, line);
   EXPECT_HAS(yaml, "mounting_deg: [0.5, -1.25, 90]");
 }
+
+TEST(IoManifest, LargeAndSmallNumbersArePlainDigits) {
+  Manifest m;
+  ModuleSpec s;
+  s.name = "w";
+  s.file = "w.bin";
+  s.wheel_radius = 0.097;
+  s.noise.acc_bias_std = 2e-5;
+  m.modules.push_back(s);
+  m.static_start = 100000.0;
+  m.static_end = 100030.0;
+  const std::string yaml = manifest_to_yaml(m, ".");
+  EXPECT_HAS(yaml, "static_period_s: [100000, 100030]");
+  EXPECT_HAS(yaml, "acc_bias_m_s2: 0.00002\n");
+  ScratchDir dir;
+  save_manifest(m, dir / "m.yaml");
+  const Manifest back = load_manifest(dir / "m.yaml", kQuiet);
+  EXPECT_EQ(back.static_start, 100000.0);
+  EXPECT_EQ(back.modules[0].noise.acc_bias_std, 2e-5);
+}

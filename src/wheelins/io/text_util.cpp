@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstring>
 #include <limits>
 #include <iostream>
 #include <vector>
@@ -21,7 +23,11 @@ std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'
 
 std::string format_double(double v) {
   char buf[64];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  auto res = std::to_chars(buf, buf + sizeof buf, v);
+  // Shortest may pick "1e+05" for 100000: people read plain digits better in the usual range.
+  const double a = std::abs(v);
+  if (std::memchr(buf, 'e', static_cast<std::size_t>(res.ptr - buf)) && a >= 1e-5 && a < 1e16)
+    res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed);
   return std::string(buf, res.ptr);
 }
 

@@ -12,7 +12,8 @@ namespace wheelins::io_detail {
 /// "'path'" as every I/O message names a file.
 std::string quote(const std::filesystem::path& p);
 
-/// Shortest decimal text that parses back to exactly `v` ("0.097", "200", "1e-06").
+/// Shortest decimal text that parses back to exactly `v` ("0.097", "200", "100000",
+/// "0.000001"; scientific only outside [1e-5, 1e16)).
 std::string format_double(double v);
 
 /// Parses the whole of `s` (surrounding blanks allowed, a leading '+' allowed) as a
