@@ -1,5 +1,6 @@
 #include "wheelins/fusion/navigator.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -106,12 +107,19 @@ void Navigator::process(int index, const ImuSample& raw) {
 
   // Updates when every subsystem has reached the scheduled time.
   const double t_all = min_time();
+  using Clock = std::chrono::steady_clock;
   if (t_all + 1e-9 >= next_velocity_t_) {
+    const auto t0 = Clock::now();
     velocity_updates();
+    stats_.velocity_step_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+    ++stats_.velocity_steps;
     while (next_velocity_t_ <= t_all + 1e-9) next_velocity_t_ += opt_.wheel.velocity_update_interval;
   }
   if (subs_.size() > 1 && opt_.fusion.position_constraint && t_all + 1e-9 >= next_position_t_) {
+    const auto t0 = Clock::now();
     position_update();
+    stats_.position_step_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+    ++stats_.position_steps;
     while (next_position_t_ <= t_all + 1e-9)
       next_position_t_ += opt_.fusion.position_update_interval;
   }

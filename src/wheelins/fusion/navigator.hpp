@@ -67,6 +67,10 @@ struct NavigatorStats {
   double t_start = 0.0, t_end = 0.0;    ///< navigation interval [s]
   double max_velocity_test_ratio = 0.0;
   double max_position_test_ratio = 0.0;
+  /// Time spent in the velocity-update and position-constraint steps (all subsystems) and
+  /// their number of occurrences, for the paper's Table 8 [s].
+  double velocity_step_seconds = 0.0, position_step_seconds = 0.0;
+  std::uint64_t velocity_steps = 0, position_steps = 0;
 };
 
 class Navigator {

@@ -73,15 +73,28 @@ RunResult run_navigation(const RunRequest& r) {
   });
 
   Progress progress("navigating", total_rows, r.progress);
-  std::size_t index = 0;
-  ImuSample s;
+  // Samples are read in blocks, and only the processing of a block is timed: the
+  // filter's own cost, without file reading, at two clock reads per 4096 samples.
+  constexpr std::size_t kBlock = 4096;
+  std::vector<std::pair<std::size_t, ImuSample>> block(kBlock);
   std::uint64_t n = 0;
-  while (merger.next(index, s)) {
-    nav.process(static_cast<int>(index), s);
-    if ((++n & 0x3FFF) == 0) progress.update(n);
-    if (r.max_duration > 0 && nav.navigating() &&
-        s.t - nav.stats().t_start >= r.max_duration)
-      break;
+  double filter_seconds = 0.0;
+  bool more = true, stop = false;
+  while (more && !stop) {
+    std::size_t count = 0;
+    while (count < kBlock && (more = merger.next(block[count].first, block[count].second))) ++count;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t k = 0; k < count; ++k) {
+      const ImuSample& s = block[k].second;
+      nav.process(static_cast<int>(block[k].first), s);
+      if (r.max_duration > 0 && nav.navigating() && s.t - nav.stats().t_start >= r.max_duration) {
+        stop = true;
+        break;
+      }
+    }
+    filter_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    n += count;
+    progress.update(n);
   }
   progress.finish();
   if (!nav.navigating())
@@ -94,6 +107,7 @@ RunResult run_navigation(const RunRequest& r) {
   for (auto& w : subsystems) w->commit();
   result.files = outputs;
   result.stats = nav.stats();
+  result.filter_seconds = filter_seconds;
   result.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;

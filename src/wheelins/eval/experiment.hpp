@@ -1,0 +1,63 @@
+// The paper's experiment (Section VI): every configuration and chip combination
+// of a dataset, evaluated against its truth, summarised as Tables 4-8.
+//
+// Runs: 8 single Wheel-INS (left C1-C4, right C1-C4); 16 Dual Wheel-INS (left Ci,
+// right Cj); 16 Body/Wheel-INS (left Ci, body Cj); 16 Triple INS (left Ci, right Cj,
+// body C(((i+j) mod 4) + 1)); and the first 8 Triple INS combinations again with the
+// centralized filter (Table 7/8).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "wheelins/eval/metrics.hpp"
+#include "wheelins/fusion/navigator.hpp"
+#include "wheelins/io/diagnostics.hpp"
+
+namespace wheelins::eval {
+
+struct ExperimentOptions {
+  NavigatorOptions nav;           ///< filter settings shared by every run
+  int jobs = 2;                   ///< runs in parallel
+  double duration = 0.0;          ///< navigation per run [s]; 0 = all data
+  bool progress = true;
+  /// Configurations to run (single, dual-wheel, body-wheel, triple, centralized); empty = all.
+  std::vector<std::string> only;
+  /// Keep the per-epoch error series of the figure runs (for plots).
+  bool keep_series = true;
+  WarningSink warn;
+};
+
+struct ExperimentRun {
+  std::string configuration;         ///< single | dual-wheel | body-wheel | triple
+  bool centralized = false;
+  std::vector<std::string> modules;
+  std::string label;                 ///< chip digits, e.g. "14" (left C1, right C4)
+  std::string side;                  ///< single: "left" | "right"
+  EvalResult eval;                   ///< series kept only for figure runs
+  NavigatorStats stats;
+  double filter_seconds = 0.0;
+  bool figure = false;               ///< one of the paper's Fig. 7-9 runs
+};
+
+struct ExperimentResult {
+  std::filesystem::path manifest;
+  std::string dataset_name;
+  std::vector<ExperimentRun> runs;
+  double wall_seconds = 0.0;
+};
+
+/// The run list for a manifest (needs 4 chips per module group, or fewer: combinations
+/// shrink to what the manifest has).
+std::vector<ExperimentRun> experiment_plan(const Manifest& m, const ExperimentOptions& o);
+
+ExperimentResult run_experiment(const std::filesystem::path& manifest, const ExperimentOptions& o);
+
+/// Tables 4-8 in the paper's layout (Markdown), with a header naming the dataset.
+std::string experiment_markdown(const ExperimentResult& r);
+/// One row per run (CSV, with a header) / everything as JSON.
+std::string experiment_csv(const ExperimentResult& r);
+std::string experiment_json(const ExperimentResult& r);
+
+}  // namespace wheelins::eval
