@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 
@@ -29,6 +30,12 @@ constexpr double kScanSeconds = 900.0;   // how far into the data the static per
 constexpr double kRobotWheelRadius = 0.097;
 constexpr double kRobotTrack = 0.33;
 const Vec3 kRobotLeverArm(-0.015, 0.005, 0.005);
+
+std::string seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f s", s);
+  return buf;
+}
 
 struct Found {
   std::string name, group, chip;
@@ -266,8 +273,8 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
   }
   d.facts.push_back(d.layout + " layout: " + std::to_string(m.modules.size()) + " IMU module(s) in " + quote(dir_in));
   if (start - earliest > 1.0)
-    d.facts.push_back("the modules start " + format_double(start - earliest) +
-                      " s apart; the static period begins when all have data");
+    d.facts.push_back("the modules start " + seconds(start - earliest) +
+                      " apart; the static period begins when all have data");
 
   // The static period: from the truth velocity, else the odometer, else a wheel gyro.
   std::optional<double> motion;
@@ -295,7 +302,7 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
       d.todo.push_back("initial.heading_deg: the vehicle heading at the start (the truth has no attitude)");
     }
     if (ts->starts_late)
-      d.facts.push_back("the truth starts " + format_double(ts->t - start) + " s after the IMU data");
+      d.facts.push_back("the truth starts " + seconds(ts->t - start) + " after the IMU data");
     if (ts->t < start)
       d.facts.push_back("the truth ends before the IMU data start (different time bases?); "
                         "its last record was used");
@@ -330,8 +337,7 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
     m.static_end = *motion - kStaticMargin;
     note["static_period_s"] = "until " + format_double(kStaticMargin) + " s before the first motion (" +
                               motion_source + ")";
-    d.facts.push_back("static period " + format_double(m.static_end - m.static_start) + " s (" +
-                      motion_source + ")");
+    d.facts.push_back("static period " + seconds(m.static_end - m.static_start) + " (" + motion_source + ")");
   } else {
     note["static_period_s"] = "TODO: no static period found at the start; set one";
     d.todo.push_back("static_period_s: no static period found at the start of the data");
