@@ -153,6 +153,8 @@ ExperimentResult run_experiment(const fs::path& manifest_file, const ExperimentO
         if (o.keep_series && run.figure)
           for (std::size_t k = 0; k < run.eval.series.size(); k += 20) kept.push_back(run.eval.series[k]);
         run.eval.series = std::move(kept);
+        if (o.keep_series && run.figure)
+          for (std::size_t k = 0; k < traj.records.size(); k += 20) run.track.push_back(traj.records[k]);
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
         if (!failure) failure = std::current_exception();

@@ -35,7 +35,8 @@ struct ExperimentRun {
   std::vector<std::string> modules;
   std::string label;                 ///< chip digits, e.g. "14" (left C1, right C4)
   std::string side;                  ///< single: "left" | "right"
-  EvalResult eval;                   ///< series kept only for figure runs
+  EvalResult eval;                   ///< series (10 Hz) kept only for figure runs
+  std::vector<TrajectoryRecord> track;  ///< 1 Hz vehicle solution, figure runs only
   NavigatorStats stats;
   double filter_seconds = 0.0;
   bool figure = false;               ///< one of the paper's Fig. 7-9 runs
