@@ -50,6 +50,32 @@ Vec21 noise_density(const ProcessNoise& q) {
 }
 }  // namespace
 
+ErrorDynamics error_dynamics_blocks(const Mat3& C, const Vec3& omega_b, const Vec3& f_b,
+                                    const Vec3& omega_ie, const ProcessNoise& q) {
+  ErrorDynamics d;
+  d.W = skew(omega_ie);
+  d.Ff = skew(C * f_b);
+  d.C = C;
+  d.Cf = C * f_b.asDiagonal();
+  d.Cw = C * omega_b.asDiagonal();
+  d.decay_bg = 1.0 / q.gyro_bias_tau;
+  d.decay_ba = 1.0 / q.acc_bias_tau;
+  d.decay_sg = 1.0 / q.gyro_sf_tau;
+  d.decay_sa = 1.0 / q.acc_sf_tau;
+  return d;
+}
+
+Vec21 discrete_noise_diagonal(const ProcessNoise& q, double dt) { return noise_density(q) * dt; }
+
+void propagate_covariance(Mat21& P, const ErrorDynamics& d, const ProcessNoise& q, double dt) {
+  // Phi P Phi^T = (Phi (Phi P)^T)^T: two left-applications of the block-sparse Phi.
+  apply_transition<kStateDim>(d, dt, P);
+  P.transposeInPlace();
+  apply_transition<kStateDim>(d, dt, P);
+  P.diagonal() += discrete_noise_diagonal(q, dt);
+  P = 0.5 * (P + P.transpose()).eval();
+}
+
 Mat21 transition_matrix(const Mat21& F, double dt) {
   Mat21 Phi = F * dt;
   Phi.diagonal().array() += 1.0;

@@ -27,8 +27,8 @@ void StrapdownEkf::propagate_nominal(const ImuSample& raw) {
   mechanize(mech_, have_last_ ? last_ : cur, cur, state_);
   last_ = cur;
   have_last_ = true;
-  F_ = error_dynamics(state_.C_ItoW(), cur.dtheta / cur.dt, cur.dvel / cur.dt,
-                      mech_.omega_ie_inW, noise_);
+  dyn_ = error_dynamics_blocks(state_.C_ItoW(), cur.dtheta / cur.dt, cur.dvel / cur.dt,
+                              mech_.omega_ie_inW, noise_);
 }
 
 void StrapdownEkf::feedback(const Vec21& dx) {

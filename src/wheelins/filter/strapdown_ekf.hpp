@@ -29,15 +29,15 @@ class StrapdownEkf {
   /// IMU b-frame (mounting already applied), as increments.
   void propagate(const ImuSample& raw) {
     propagate_nominal(raw);
-    if (own_covariance_) propagate_covariance(P_, F_, noise_, last_.dt);
+    if (own_covariance_) propagate_covariance(P_, dyn_, noise_, last_.dt);
   }
   /// A centralized filter keeps the covariance: propagate() then skips this one's P.
   void set_external_covariance(bool external) { own_covariance_ = !external; }
   /// The nominal part only (compensation, mechanization, F of this epoch); a
   /// centralized filter propagates the joint covariance itself.
   void propagate_nominal(const ImuSample& raw);
-  /// F of the last epoch (error_dynamics at the propagated state).
-  const Mat21& last_F() const { return F_; }
+  /// The blocks of F of the last epoch (at the propagated state).
+  const ErrorDynamics& last_dynamics() const { return dyn_; }
   const ProcessNoise& noise() const { return noise_; }
 
   /// Fuses a measurement (dz = z_hat - z_meas = H dx + e) and feeds the error back.
@@ -69,7 +69,7 @@ class StrapdownEkf {
   NavState state_;
   ImuErrors errors_;
   Mat21 P_ = Mat21::Zero();
-  Mat21 F_ = Mat21::Zero();
+  ErrorDynamics dyn_;
   ProcessNoise noise_;
   MechanizationOptions mech_;
   ImuSample last_;

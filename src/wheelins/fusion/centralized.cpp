@@ -25,18 +25,18 @@ class FixedJointCovariance final : public JointCovariance {
     return P_.template block<kStateDim, kStateDim>(kStateDim * i, kStateDim * i);
   }
 
-  void propagate(int i, const Mat21& F, const ProcessNoise& q, double dt) override {
-    // Phi_big = diag(I, .., Phi_i, .., I): row block i <- Phi_i * row block i,
+  void propagate(int i, const ErrorDynamics& d, const ProcessNoise& q, double dt) override {
+    // Phi_big = diag(I, .., Phi_i, .., I): row block i <- Phi_i * row block i, then
     // column block i <- column block i * Phi_i^T, plus Qd_i on the diagonal block.
-    const Mat21 Phi = transition_matrix(F, dt);
     const int o = kStateDim * i;
-    const Eigen::Matrix<double, kStateDim, D> rows = Phi * P_.template middleRows<kStateDim>(o);
+    Eigen::Matrix<double, kStateDim, D> rows = P_.template middleRows<kStateDim>(o);
+    apply_transition<D>(d, dt, rows);
     P_.template middleRows<kStateDim>(o) = rows;
-    const Eigen::Matrix<double, D, kStateDim> cols =
-        P_.template middleCols<kStateDim>(o) * Phi.transpose();
-    P_.template middleCols<kStateDim>(o) = cols;
+    rows = P_.template middleCols<kStateDim>(o).transpose();
+    apply_transition<D>(d, dt, rows);
+    P_.template middleCols<kStateDim>(o) = rows.transpose();
     auto Pii = P_.template block<kStateDim, kStateDim>(o, o);
-    Pii += discrete_noise(Phi, q, dt);
+    Pii.diagonal() += discrete_noise_diagonal(q, dt);
     const Mat21 sym = 0.5 * (Mat21(Pii) + Mat21(Pii).transpose());
     Pii = sym;
   }

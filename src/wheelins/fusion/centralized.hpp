@@ -24,7 +24,7 @@ class JointCovariance {
   virtual void set_block(int i, const Mat21& P) = 0;
   virtual Mat21 block(int i) const = 0;
   /// Subsystem i advanced by one epoch (F_i over dt); the others did not move.
-  virtual void propagate(int i, const Mat21& F, const ProcessNoise& q, double dt) = 0;
+  virtual void propagate(int i, const ErrorDynamics& d, const ProcessNoise& q, double dt) = 0;
   /// Fuses dz = sum_j H_j dx_j + e (H[j] == nullptr: no dependence on subsystem j),
   /// writing each subsystem's error estimate into dx[j].
   virtual UpdateReport update(const std::array<const H3*, kMaxCentralized>& H, const Vec3& dz,

@@ -103,7 +103,7 @@ void Navigator::process(int index, const ImuSample& raw) {
     start_navigation(manifest_.static_end);
   }
   s.propagate(b);
-  if (joint_) joint_->propagate(index, s.ekf().last_F(), s.ekf().noise(), b.dt);
+  if (joint_) joint_->propagate(index, s.ekf().last_dynamics(), s.ekf().noise(), b.dt);
 
   // Updates when every subsystem has reached the scheduled time.
   const double t_all = min_time();
