@@ -179,3 +179,20 @@ TEST_F(NavEndToEnd, RunWritesFilesAndNeverOverwritesUnasked) {
   EXPECT_NO_THROW(run_navigation(r));
   fs::remove_all(out);
 }
+
+TEST_F(NavEndToEnd, CentralizedEqualsDistributedWithoutConstraint) {
+  // Without the position constraint no cross-correlation arises, so the joint
+  // covariance must reproduce the distributed filter exactly: a check of the joint
+  // propagation and update against the per-subsystem ones.
+  const Manifest m = load_manifest(*field_ / "manifest.yaml", {});
+  const auto modules = configuration_modules(m, "triple", {});
+  NavigatorOptions nav;
+  nav.fusion.position_constraint = false;
+  nav.fusion.speed = SpeedSharing::kOwn;
+  const Outcome d = navigate(*field_, modules, nav, 120.0);
+  nav.fusion.centralized = true;
+  const Outcome c = navigate(*field_, modules, nav, 120.0);
+  EXPECT_NEAR(c.eval.max_error, d.eval.max_error, 1e-6);
+  EXPECT_NEAR(c.eval.heading_rmse, d.eval.heading_rmse, 1e-9);
+  EXPECT_NEAR(c.eval.mean_nees, d.eval.mean_nees, 1e-6);
+}
