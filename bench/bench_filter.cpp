@@ -1,0 +1,98 @@
+// Google Benchmark suite for the per-epoch hot path. Run: build/wheelins_bench
+// (make bench). Figures go to BENCHMARKS.md with the command that produced them.
+#include <benchmark/benchmark.h>
+
+#include "wheelins/filter/error_model.hpp"
+#include "wheelins/filter/wheel_velocity.hpp"
+#include "wheelins/fusion/centralized.hpp"
+#include "wheelins/nav/mechanization.hpp"
+
+using namespace wheelins;
+
+namespace {
+
+ImuSample wheel_sample() {
+  ImuSample s;
+  s.dt = 0.005;
+  s.t = 100.0;
+  s.dtheta = Vec3(-14.4, 0.05, -0.02) * s.dt;
+  s.dvel = Vec3(0.3, -4.1, -8.9) * s.dt;
+  return s;
+}
+
+Mat21 some_covariance() {
+  Mat21 A = Mat21::Random() * 0.01;
+  return A * A.transpose() + Mat21::Identity() * 1e-6;
+}
+
+void BM_Mechanize(benchmark::State& state) {
+  MechanizationOptions opt;
+  opt.omega_ie_inW = Vec3(6.3e-5, 0, -3.7e-5);
+  NavState nav;
+  nav.q_ItoW = quat_from_euler(Vec3(0.3, 0.01, 1.2));
+  const ImuSample s = wheel_sample();
+  for (auto _ : state) {
+    mechanize(opt, s, s, nav);
+    benchmark::DoNotOptimize(nav);
+  }
+}
+BENCHMARK(BM_Mechanize);
+
+void BM_CovarianceDense(benchmark::State& state) {
+  Mat21 P = some_covariance();
+  const Mat21 F = error_dynamics(dcm_from_euler(Vec3(0.3, 0.01, 1.2)), Vec3(-14.4, 0.05, -0.02),
+                                 Vec3(0.3, -4.1, -8.9), Vec3(6.3e-5, 0, -3.7e-5), ProcessNoise{});
+  for (auto _ : state) {
+    propagate_covariance(P, F, ProcessNoise{}, 0.005);
+    benchmark::DoNotOptimize(P);
+  }
+}
+BENCHMARK(BM_CovarianceDense);
+
+void BM_CovarianceSparse(benchmark::State& state) {
+  Mat21 P = some_covariance();
+  const ErrorDynamics d = error_dynamics_blocks(dcm_from_euler(Vec3(0.3, 0.01, 1.2)),
+                                                Vec3(-14.4, 0.05, -0.02), Vec3(0.3, -4.1, -8.9),
+                                                Vec3(6.3e-5, 0, -3.7e-5), ProcessNoise{});
+  for (auto _ : state) {
+    propagate_covariance(P, d, ProcessNoise{}, 0.005);
+    benchmark::DoNotOptimize(P);
+  }
+}
+BENCHMARK(BM_CovarianceSparse);
+
+void BM_WheelVelocityUpdate(benchmark::State& state) {
+  WheelVelocityInput in;
+  in.C_BtoW = dcm_from_euler(Vec3(0.3, 0.01, 1.2));
+  in.v_IinW = Vec3(1.0, 0.9, 0.0);
+  in.omega_ib_b = Vec3(-14.4, 0.05, -0.02);
+  in.lever_arm_inB = Vec3(0.015, -0.004, 0.006);
+  set_own_wheel_speed(in, 0.097, -14.3);
+  const Mat21 P0 = some_covariance();
+  const Mat3 R = Vec3(0.03, 0.02, 0.02).cwiseAbs2().asDiagonal();
+  for (auto _ : state) {
+    Mat21 P = P0;
+    Vec21 dx = Vec21::Zero();
+    const WheelVelocityModel m = wheel_velocity_model(in);
+    benchmark::DoNotOptimize(ekf_update<3>(P, dx, m.H, m.innovation(), R));
+    benchmark::DoNotOptimize(P);
+  }
+}
+BENCHMARK(BM_WheelVelocityUpdate);
+
+void BM_CentralizedPropagateTriple(benchmark::State& state) {
+  auto joint = make_joint_covariance(3);
+  for (int i = 0; i < 3; ++i) joint->set_block(i, some_covariance());
+  const ErrorDynamics d = error_dynamics_blocks(dcm_from_euler(Vec3(0.3, 0.01, 1.2)),
+                                                Vec3(-14.4, 0.05, -0.02), Vec3(0.3, -4.1, -8.9),
+                                                Vec3(6.3e-5, 0, -3.7e-5), ProcessNoise{});
+  for (auto _ : state) {
+    for (int i = 0; i < 3; ++i) joint->propagate(i, d, ProcessNoise{}, 0.005);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_CentralizedPropagateTriple);
+
+}  // namespace
+
+BENCHMARK_MAIN();
