@@ -102,7 +102,7 @@ TEST(FusionRunConfig, BadValuesNameTheKeyAndLine) {
   e = load("dataset: [unclosed\n");
   EXPECT_NE(e.find("malformed YAML"), std::string::npos) << e;
   e = error_of([&] { load_run_config(dir / "missing.yaml", {}); });
-  EXPECT_NE(e.find("missing.yaml': file not found"), std::string::npos) << e;
+  EXPECT_NE(e.find("missing.yaml': run configuration file not found"), std::string::npos) << e;
 }
 
 TEST(FusionRunConfig, UnknownKeyWarnsWithClosestKnown) {

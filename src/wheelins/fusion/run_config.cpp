@@ -13,7 +13,7 @@ SpeedSharing speed_sharing_from_name(const std::string& name) {
 }
 
 RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
-  const YamlReader y(file, warn);
+  const YamlReader y(file, warn, "run configuration");
   const YAML::Node& root = y.root();
   y.check_keys(root, "", {"dataset", "configuration", "chips", "modules", "output", "duration_s",
                           "filter", "fusion"});

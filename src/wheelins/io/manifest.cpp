@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "wheelins/io/text_util.hpp"
+#include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins {
@@ -136,86 +137,13 @@ std::vector<std::string> noise_key_names() {
   return v;
 }
 
-std::string join(const std::string& path, const std::string& key) {
-  return path.empty() ? key : path + "." + key;
-}
-std::string index_path(const std::string& path, std::size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-std::string describe(const YAML::Node& n) {
-  switch (n.Type()) {
-    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Map: return "a mapping";
-    case YAML::NodeType::Null: return "nothing (empty value)";
-    default: return "nothing";
-  }
-}
-
-/// Reads one manifest, remembering the file name for every message.
-class Loader {
+/// Reads one manifest: the generic YAML checks come from YamlReader; the manifest adds
+/// its exact human-unit conversion (Unit) and its own structure.
+class Loader : public YamlReader {
  public:
-  Loader(const fs::path& file, const WarningSink& warn) : file_(file), warn_(warn) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& what,
-                         const YAML::Node* at = nullptr) const {
-    std::string msg = quote(file_) + ": " + (key.empty() ? "" : key + ": ") + what;
-    if (at && at->IsDefined() && !at->Mark().is_null())
-      msg += " (line " + std::to_string(at->Mark().line + 1) + ")";
-    throw InputError(msg);
-  }
-
-  void require_map(const YAML::Node& n, const std::string& path) const {
-    if (!n.IsMap()) fail(path, "expected a mapping (key: value lines), got " + describe(n), &n);
-  }
-
-  /// Rejects duplicate keys and warns about unknown ones (naming the closest known key).
-  void check_keys(const YAML::Node& map, const std::string& path,
-                  const std::vector<std::string>& known) const {
-    std::set<std::string> seen;
-    for (const auto& kv : map) {
-      if (!kv.first.IsScalar())
-        fail(path, "keys must be plain names, got " + describe(kv.first), &kv.first);
-      const std::string key = kv.first.Scalar();
-      if (!seen.insert(key).second) fail(join(path, key), "duplicate key", &kv.first);
-      if (std::find(known.begin(), known.end(), key) != known.end()) continue;
-      // Closest by edit distance; a known key that extends the unknown one (a forgotten
-      // unit suffix: "wheel_radius" -> "wheel_radius_m") wins over any other.
-      std::string best;
-      std::pair<int, std::size_t> best_score{2, 0};
-      for (const auto& k : known) {
-        const bool extends = k.size() > key.size() && k.compare(0, key.size(), key) == 0;
-        const std::pair<int, std::size_t> score{extends ? 0 : 1, io_detail::edit_distance(key, k)};
-        if (score < best_score) best_score = score, best = k;
-      }
-      if (warn_) {
-        std::string msg = quote(file_) + ": " + join(path, key) + ": unknown key ignored";
-        if (!kv.first.Mark().is_null()) msg += " (line " + std::to_string(kv.first.Mark().line + 1) + ")";
-        msg += "; did you mean '" + best + "'?";
-        warn_(msg);
-      }
-    }
-  }
-
-  /// The value of `key` in `map`, or an undefined node if it is absent or null.
-  static YAML::Node get(const YAML::Node& map, const std::string& key) {
-    const YAML::Node& cmap = map;
-    YAML::Node v = cmap[key];
-    if (!v.IsDefined() || v.IsNull()) return YAML::Node(YAML::NodeType::Undefined);
-    return v;
-  }
-
-  YAML::Node required(const YAML::Node& map, const std::string& path, const std::string& key) const {
-    YAML::Node v = get(map, key);
-    if (!v.IsDefined()) {
-      const YAML::Node& cmap = map;
-      if (cmap[key].IsDefined())
-        fail(join(path, key), "required value is empty", &map);
-      fail(path, "missing required key '" + key + "'", &map);
-    }
-    return v;
-  }
+  Loader(const fs::path& file, const WarningSink& warn)
+      : YamlReader(file, warn, "manifest", " (create one with `wheelins manifest DIR`)"),
+        file_(file) {}
 
   double number(const YAML::Node& v, const std::string& path, Unit u = kOne) const {
     if (!v.IsScalar()) fail(path, "expected a number, got " + describe(v), &v);
@@ -223,23 +151,6 @@ class Loader {
     if (!x) fail(path, "expected a number, got " + describe(v), &v);
     if (!std::isfinite(*x)) fail(path, "expected a finite number, got " + describe(v), &v);
     return *x;
-  }
-
-  std::string text(const YAML::Node& v, const std::string& path) const {
-    if (!v.IsScalar()) fail(path, "expected a text value, got " + describe(v), &v);
-    if (v.Scalar().empty()) fail(path, "expected a non-empty text value", &v);
-    return v.Scalar();
-  }
-
-  bool boolean(const YAML::Node& v, const std::string& path) const {
-    if (v.IsScalar()) {
-      std::string s = v.Scalar();
-      std::transform(s.begin(), s.end(), s.begin(),
-                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-      if (s == "true" || s == "yes" || s == "on") return true;
-      if (s == "false" || s == "no" || s == "off") return false;
-    }
-    fail(path, "expected true or false, got " + describe(v), &v);
   }
 
   Vec3 vec3(const YAML::Node& v, const std::string& path, Unit u = kOne) const {
@@ -250,17 +161,6 @@ class Loader {
     Vec3 out;
     for (std::size_t i = 0; i < 3; ++i) out[static_cast<int>(i)] = number(v[i], index_path(path, i), u);
     return out;
-  }
-
-  template <class E>
-  E choice(const YAML::Node& v, const std::string& path,
-           const std::vector<std::pair<std::string, E>>& options) const {
-    if (v.IsScalar())
-      for (const auto& [name, value] : options)
-        if (v.Scalar() == name) return value;
-    std::string list;
-    for (const auto& o : options) list += (list.empty() ? "" : " or ") + o.first;
-    fail(path, "expected " + list + ", got " + describe(v), &v);
   }
 
   void positive(double x, const std::string& path, const YAML::Node& at, const char* what) const {
@@ -275,32 +175,10 @@ class Loader {
   void noise(const YAML::Node& n, const std::string& path, ImuNoise& out) const;
 
   fs::path file_;
-  const WarningSink& warn_;
 };
 
 Manifest Loader::load() {
-  std::error_code ec;
-  const auto st = fs::status(file_, ec);
-  if (ec || !fs::exists(st)) fail("", "manifest file not found");
-  if (fs::is_directory(st))
-    fail("", "is a directory, expected a manifest file (create one with `wheelins manifest DIR`)");
-  std::ifstream in(file_, std::ios::binary);
-  if (!in) fail("", std::string("cannot open: ") + std::strerror(errno));
-  std::stringstream buf;
-  buf << in.rdbuf();
-
-  YAML::Node root;
-  try {
-    root = YAML::Load(buf.str());
-  } catch (const YAML::Exception& e) {
-    std::string where;
-    if (!e.mark.is_null())
-      where = "line " + std::to_string(e.mark.line + 1) + ", column " +
-              std::to_string(e.mark.column + 1) + ": ";
-    fail("", where + "malformed YAML: " + e.msg);
-  }
-  if (!root.IsDefined() || root.IsNull()) fail("", "the manifest is empty");
-  require_map(root, "");
+  const YAML::Node& root = this->root();
   check_keys(root, "", kTopKeys);
 
   Manifest m;
@@ -371,7 +249,7 @@ Manifest Loader::load() {
     fail("modules", "expected a list of modules ('- name: ...' entries), got " + describe(mods), &mods);
   if (mods.size() == 0) fail("modules", "no IMU module listed; a manifest needs at least one", &mods);
   for (std::size_t i = 0; i < mods.size(); ++i) {
-    const std::string path = index_path("modules", i);
+    const std::string path = YamlReader::index_path("modules", i);
     const YAML::Node entry = mods[i];
     m.modules.push_back(module(entry, path));
     for (std::size_t j = 0; j < i; ++j)
@@ -569,9 +447,9 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
   w.line(0, "modules:", "modules");
   for (std::size_t i = 0; i < m.modules.size(); ++i) {
     const ModuleSpec& s = m.modules[i];
-    const std::string p = index_path("modules", i) + ".";
+    const std::string p = YamlReader::index_path("modules", i) + ".";
     const bool wheel = s.kind == ModuleKind::kWheel;
-    w.line(2, "- name: " + yaml_string(s.name), index_path("modules", i));
+    w.line(2, "- name: " + yaml_string(s.name), YamlReader::index_path("modules", i));
     w.line(4, std::string("kind: ") + to_string(s.kind), p + "kind");
     if (!s.group.empty()) w.line(4, "group: " + yaml_string(s.group), p + "group");
     if (!s.chip.empty()) w.line(4, "chip: " + yaml_string(s.chip), p + "chip");

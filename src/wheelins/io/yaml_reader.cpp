@@ -30,11 +30,13 @@ std::string YamlReader::describe(const YAML::Node& n) {
   }
 }
 
-YamlReader::YamlReader(const fs::path& file, WarningSink warn) : file_(file), warn_(std::move(warn)) {
+YamlReader::YamlReader(const fs::path& file, WarningSink warn, std::string kind,
+                       std::string directory_hint)
+    : file_(file), warn_(std::move(warn)) {
   std::error_code ec;
   const auto st = fs::status(file_, ec);
-  if (ec || !fs::exists(st)) fail("", "file not found");
-  if (fs::is_directory(st)) fail("", "is a directory, expected a YAML file");
+  if (ec || !fs::exists(st)) fail("", kind + " file not found");
+  if (fs::is_directory(st)) fail("", "is a directory, expected a " + kind + " file" + directory_hint);
   std::ifstream in(file_, std::ios::binary);
   if (!in) fail("", std::string("cannot open: ") + std::strerror(errno));
   std::stringstream buf;
@@ -48,7 +50,7 @@ YamlReader::YamlReader(const fs::path& file, WarningSink warn) : file_(file), wa
               std::to_string(e.mark.column + 1) + ": ";
     fail("", where + "malformed YAML: " + e.msg);
   }
-  if (!root_.IsDefined() || root_.IsNull()) fail("", "the file is empty");
+  if (!root_.IsDefined() || root_.IsNull()) fail("", "the " + kind + " is empty");
   require_map(root_, "");
 }
 
@@ -72,10 +74,11 @@ void YamlReader::check_keys(const YAML::Node& map, const std::string& path,
     if (!seen.insert(key).second) fail(join(path, key), "duplicate key", &kv.first);
     if (std::find(known.begin(), known.end(), key) != known.end()) continue;
     std::string best;
-    std::size_t best_d = std::string::npos;
+    std::pair<int, std::size_t> best_score{2, 0};
     for (const auto& k : known) {
-      const std::size_t d = io_detail::edit_distance(key, k);
-      if (d < best_d) best_d = d, best = k;
+      const bool extends = k.size() > key.size() && k.compare(0, key.size(), key) == 0;
+      const std::pair<int, std::size_t> score{extends ? 0 : 1, io_detail::edit_distance(key, k)};
+      if (score < best_score) best_score = score, best = k;
     }
     if (warn_) {
       std::string msg = io_detail::quote(file_) + ": " + join(path, key) + ": unknown key ignored";

@@ -19,7 +19,10 @@ namespace wheelins {
 class YamlReader {
  public:
   /// Parses `file` (InputError if missing, a directory, unreadable, malformed or empty).
-  YamlReader(const std::filesystem::path& file, WarningSink warn);
+  /// `kind` names the file in messages ("manifest", "run configuration"); `directory_hint`
+  /// is appended when a directory was given instead.
+  YamlReader(const std::filesystem::path& file, WarningSink warn, std::string kind = "YAML",
+             std::string directory_hint = "");
 
   const YAML::Node& root() const { return root_; }
   const std::filesystem::path& file() const { return file_; }
@@ -27,7 +30,9 @@ class YamlReader {
   [[noreturn]] void fail(const std::string& key, const std::string& what,
                          const YAML::Node* at = nullptr) const;
   void require_map(const YAML::Node& n, const std::string& path) const;
-  /// Warns about keys not in `known` (naming the closest) and rejects duplicates.
+  /// Warns about keys not in `known` (naming the closest: a known key that extends the
+  /// unknown one, i.e. a forgotten unit suffix, first, then by edit distance) and
+  /// rejects duplicates.
   void check_keys(const YAML::Node& map, const std::string& path,
                   const std::vector<std::string>& known) const;
   /// The value at `key`, or an undefined node if absent or empty.
