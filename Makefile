@@ -5,7 +5,7 @@ WHEELINS_WERROR ?= OFF
 DEMO_DIR ?= out/demo
 WHEELINS := $(BUILD)/wheelins
 
-.PHONY: all setup configure build demo test bench clean format
+.PHONY: all setup configure build build-cli demo test bench clean format
 
 all: build
 
@@ -18,8 +18,11 @@ configure: setup
 build: configure
 	@cmake --build $(BUILD) -j$(JOBS)
 
+build-cli: configure
+	@cmake --build $(BUILD) -j$(JOBS) --target wheelins
+
 # Simulate the built-in default scenario, then run the main job on it.
-demo: build
+demo: build-cli
 	@scripts/demo.sh $(WHEELINS) $(DEMO_DIR)
 
 test: build
