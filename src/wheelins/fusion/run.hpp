@@ -32,7 +32,7 @@ struct RunRequest {
 struct RunResult {
   NavigatorStats stats;
   double wall_seconds = 0.0;
-  double filter_seconds = 0.0;  ///< time inside the navigator (no file reading or writing)
+  double filter_seconds = 0.0;  ///< time inside the navigator, output sink included (no input reading)
   std::vector<std::filesystem::path> files;  ///< what was written
 };
 
