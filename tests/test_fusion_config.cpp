@@ -114,3 +114,14 @@ TEST(FusionRunConfig, UnknownKeyWarnsWithClosestKnown) {
   EXPECT_NE(warnings[0].find("fusion.centralised: unknown key ignored (line 3); did you mean 'centralized'?"),
             std::string::npos) << warnings[0];
 }
+
+TEST(FusionNavigator, NeedsAWheelImuAndKnownModules) {
+  Manifest m = three_groups();
+  const auto err = [&](const std::vector<std::string>& mods) {
+    return error_of([&] { Navigator(m, mods, NavigatorOptions{}, [](int, const TrajectoryRecord&) {}); });
+  };
+  EXPECT_NE(err({"body-C1"}).find("no Wheel-IMU among the selected modules"), std::string::npos);
+  EXPECT_NE(err({"left-C1", "left-C9"}).find("no module named 'left-C9'"), std::string::npos);
+  EXPECT_NE(err({"left-C1", "body-C1", "body-C4"}).find("only one Body-IMU"), std::string::npos);
+  EXPECT_NE(err({}).find("no module selected"), std::string::npos);
+}
