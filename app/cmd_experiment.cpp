@@ -1,12 +1,15 @@
 // `wheelins experiment`: every configuration and chip combination of the paper's
-// Section VI on one dataset; Tables 4-8 to the terminal, CSV/JSON/Markdown to files.
+// Section VI on one dataset; Tables 4-8 to the terminal, CSV/JSON/Markdown to files,
+// and the plots of Fig. 7-10 (data + gnuplot scripts, PNGs when gnuplot is installed).
 #include <iostream>
 #include <sstream>
 
 #include "cli.hpp"
 #include "wheelins/eval/experiment.hpp"
+#include "wheelins/eval/plots.hpp"
 #include "wheelins/fusion/run_config.hpp"
 #include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/truth.hpp"
 
 namespace {
 using namespace wheelins;
@@ -21,6 +24,7 @@ struct Args {
   double duration = 0.0;
   bool force = false;
   bool quiet = false;
+  bool no_plots = false;
 };
 
 void write_file(const fs::path& file, const std::string& text, bool overwrite) {
@@ -35,6 +39,8 @@ int run(const Args& a) {
   const fs::path out = a.out.empty() ? manifest.parent_path() / "experiment" : fs::path(a.out);
   const std::vector<fs::path> files{out / "experiment.md", out / "runs.csv", out / "experiment.json"};
   for (const auto& f : files) check_output_target(f, a.force);
+  if (!a.no_plots)
+    for (const auto& f : eval::experiment_plot_targets(out)) check_output_target(f, a.force);
 
   eval::ExperimentOptions o;
   o.nav.fusion.speed = speed_sharing_from_name(a.speed);
@@ -52,8 +58,21 @@ int run(const Args& a) {
   write_file(files[0], md, a.force);
   write_file(files[1], eval::experiment_csv(r), a.force);
   write_file(files[2], eval::experiment_json(r), a.force);
+  std::vector<fs::path> plots;
+  if (!a.no_plots) {
+    const TruthData truth = read_truth(r.truth_file);
+    plots = eval::write_experiment_plots(r, truth, earth::LocalFrame(r.origin), out, a.force, o.warn);
+  }
   std::cout << md;
   for (const auto& f : files) std::cout << "wrote " << f.string() << "\n";
+  std::size_t data_files = 0;
+  for (const auto& f : plots) {
+    if (f.parent_path().filename() == "data") ++data_files;
+    else std::cout << "wrote " << f.string() << "\n";
+  }
+  if (data_files > 0)
+    std::cout << "wrote " << data_files << " plot data files (CSV) in " << (out / "plots" / "data").string()
+              << "\n";
   return 0;
 }
 
@@ -70,6 +89,7 @@ const bool registered = cli::register_command(
       sub.add_option("--duration", a->duration, "Seconds of navigation per run (default: all)");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line");
+      sub.add_flag("--no-plots", a->no_plots, "Skip the plots (OUT/plots: data, gnuplot scripts, PNGs)");
       return [a]() { return run(*a); };
     });
 }  // namespace

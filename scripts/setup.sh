@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Installs the Debian packages wheelins needs, only those that are missing.
 # Idempotent: when everything is present it only checks and returns.
+# gnuplot-nox draws the plots of `wheelins experiment` (optional at run time).
 set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  gnuplot-nox
 )
 
 missing=()

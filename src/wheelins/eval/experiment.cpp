@@ -99,12 +99,26 @@ std::vector<ExperimentRun> experiment_plan(const Manifest& m, const ExperimentOp
   if (wanted(o, "centralized"))
     for (std::size_t k = 0; k < std::min<std::size_t>(8, triples.size()); ++k) add("triple", true, triples[k], "");
 
-  // The paper's figure runs (Section VI-B-1): DW C1/C4, BW C2/C2, TW C1/C2/C4.
-  for (auto& r : plan) {
-    if (r.centralized) continue;
-    r.figure = (r.configuration == "dual-wheel" && r.label == "14") ||
-               (r.configuration == "body-wheel" && r.label == "22") ||
-               (r.configuration == "triple" && r.label == "124") || r.configuration == "single";
+  // The paper's figure runs (Section VI-B-1): DW C1/C4, BW C2/C2, TW C1/C2/C4, and
+  // every single Wheel-INS. Without the paper's combination in the plan (fewer chips,
+  // or another body chip) the run whose chips agree with it on the most leading
+  // slots is used (the first such run on a tie): e.g. TW "123" for "124".
+  for (auto& r : plan) r.figure = !r.centralized && r.configuration == "single";
+  const std::pair<std::string, std::string> paper[] = {
+      {"dual-wheel", "14"}, {"body-wheel", "22"}, {"triple", "124"}};
+  for (const auto& [config, label] : paper) {
+    ExperimentRun* pick = nullptr;
+    std::size_t best = 0;
+    for (auto& r : plan) {
+      if (r.centralized || r.configuration != config) continue;
+      std::size_t n = 0;
+      while (n < r.label.size() && n < label.size() && r.label[n] == label[n]) ++n;
+      if (!pick || n > best) {
+        pick = &r;
+        best = n;
+      }
+    }
+    if (pick) pick->figure = true;
   }
   return plan;
 }
@@ -119,6 +133,8 @@ ExperimentResult run_experiment(const fs::path& manifest_file, const ExperimentO
   const earth::LocalFrame frame(m.origin);
   res.manifest = m.path;
   res.dataset_name = m.name;
+  res.truth_file = truth.file;
+  res.origin = m.origin;
   res.runs = experiment_plan(m, o);
   if (res.runs.empty()) throw InputError("'" + manifest_file.string() + "': no run to make (no Wheel-IMU?)");
 

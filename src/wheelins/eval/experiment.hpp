@@ -14,6 +14,7 @@
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/fusion/navigator.hpp"
 #include "wheelins/io/diagnostics.hpp"
+#include "wheelins/nav/earth.hpp"
 
 namespace wheelins::eval {
 
@@ -39,12 +40,14 @@ struct ExperimentRun {
   std::vector<TrajectoryRecord> track;  ///< 1 Hz vehicle solution, figure runs only
   NavigatorStats stats;
   double filter_seconds = 0.0;
-  bool figure = false;               ///< one of the paper's Fig. 7-9 runs
+  bool figure = false;  ///< a Fig. 7-9 run (paper chips or closest, see experiment_plan)
 };
 
 struct ExperimentResult {
   std::filesystem::path manifest;
   std::string dataset_name;
+  std::filesystem::path truth_file;  ///< the truth the runs were evaluated against
+  earth::Geodetic origin;            ///< the local frame's origin (manifest)
   std::vector<ExperimentRun> runs;
   double wall_seconds = 0.0;
 };
