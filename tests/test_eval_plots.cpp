@@ -290,12 +290,12 @@ TEST(EvalPlots, FigureRunsArePaperChipsOrTheClosestCombination) {
       if (r.figure && r.configuration != "single") v.push_back(r.configuration + " " + r.label);
     return v;
   };
-  // The paper's DW 14 and BW 22; the plan's Triple INS combinations have no 124
-  // (left C1, right C2 take body C3): the closest, 123.
+  // The paper's DW 14, BW 22 and TW 124 (body chip C(((i + j) mod 4) + 1)); with two chips
+  // per module the closest: DW 11 and TW 122 (left C1, right C2, body C2).
   EXPECT_EQ(figures(eval::experiment_plan(manifest(4), {})),
-            (std::vector<std::string>{"dual-wheel 14", "body-wheel 22", "triple 123"}));
+            (std::vector<std::string>{"dual-wheel 14", "body-wheel 22", "triple 124"}));
   EXPECT_EQ(figures(eval::experiment_plan(manifest(2), {})),
-            (std::vector<std::string>{"dual-wheel 11", "body-wheel 22", "triple 121"}));
+            (std::vector<std::string>{"dual-wheel 11", "body-wheel 22", "triple 122"}));
   for (const auto& r : eval::experiment_plan(manifest(2), {})) {
     if (r.configuration == "single") {
       EXPECT_TRUE(r.figure);

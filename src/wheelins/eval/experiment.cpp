@@ -93,7 +93,8 @@ std::vector<ExperimentRun> experiment_plan(const Manifest& m, const ExperimentOp
   if (!s.body.empty())
     for (std::size_t i = 0; i < s.left.size(); ++i)
       for (std::size_t j = 0; j < s.right.size(); ++j)
-        triples.push_back({s.left[i], s.right[j], s.body[(i + j + 1) % s.body.size()]});
+        // Body chip C(((i + j) mod n) + 1) with 1-based i, j: left C1 + right C2 -> body C4.
+        triples.push_back({s.left[i], s.right[j], s.body[(i + j + 2) % s.body.size()]});
   if (wanted(o, "triple"))
     for (const auto& t : triples) add("triple", false, t, "");
   if (wanted(o, "centralized"))
