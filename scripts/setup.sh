@@ -2,6 +2,9 @@
 # Installs the Debian packages wheelins needs, only those that are missing.
 # Idempotent: when everything is present it only checks and returns.
 # gnuplot-nox draws the plots of `wheelins experiment` (optional at run time).
+# Optional groups, named as arguments: `fuzz` (clang and its libFuzzer/sanitizer
+# runtime, for scripts/fuzz.sh).
+# Usage: scripts/setup.sh [fuzz]
 set -euo pipefail
 
 packages=(
@@ -10,6 +13,12 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox
 )
+for group in "$@"; do
+  case $group in
+    fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    *) echo "setup: unknown package group '$group' (known: fuzz)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

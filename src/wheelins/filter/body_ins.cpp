@@ -16,7 +16,7 @@ void BodyIns::start(const StaticAccumulator& stat, double vehicle_heading, doubl
   s.p_IinW = C * C_BtoV_.transpose() * module_.p_inV;  // o at the origin
   ImuErrors e;
   e.bg = stat.mean_omega() - C.transpose() * mech_.omega_ie_inW;
-  ekf_.initialize(s, e, ProcessNoise::from(module_.noise), opt_.init, mech_);
+  ekf_.initialize(s, e, module_.noise, opt_.init, mech_);
 }
 
 Eigen::RowVector3d BodyIns::heading_sensitivity() const {

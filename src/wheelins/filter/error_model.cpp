@@ -2,21 +2,6 @@
 
 namespace wheelins {
 
-ProcessNoise ProcessNoise::from(const ImuNoise& n) {
-  ProcessNoise q;
-  q.gyro_arw = n.gyro_arw;
-  q.acc_vrw = n.acc_vrw;
-  q.gyro_bias_std = n.gyro_bias_std;
-  q.acc_bias_std = n.acc_bias_std;
-  q.gyro_sf_std = n.gyro_sf_std;
-  q.acc_sf_std = n.acc_sf_std;
-  q.gyro_bias_tau = n.gyro_bias_tau;
-  q.acc_bias_tau = n.acc_bias_tau;
-  q.gyro_sf_tau = n.gyro_sf_tau;
-  q.acc_sf_tau = n.acc_sf_tau;
-  return q;
-}
-
 Mat21 error_dynamics(const Mat3& C, const Vec3& omega_b, const Vec3& f_b, const Vec3& omega_ie,
                      const ProcessNoise& q) {
   Mat21 F = Mat21::Zero();

@@ -7,14 +7,9 @@
 
 namespace wheelins {
 
-/// Continuous-time white-noise densities and Gauss-Markov parameters, SI.
-struct ProcessNoise {
-  double gyro_arw = 0, acc_vrw = 0;                    ///< [rad/sqrt(s)], [m/s/sqrt(s)]
-  double gyro_bias_std = 0, acc_bias_std = 0;          ///< GM steady-state sigma
-  double gyro_sf_std = 0, acc_sf_std = 0;
-  double gyro_bias_tau = 3600, acc_bias_tau = 3600, gyro_sf_tau = 3600, acc_sf_tau = 3600;
-  static ProcessNoise from(const ImuNoise& n);
-};
+/// The noise model of the error states is the manifest's ImuNoise (SI): white noise
+/// densities (ARW, VRW) and first-order Gauss-Markov sigmas and correlation times.
+using ProcessNoise = ImuNoise;
 
 /// The continuous-time error dynamics F of eq. (2):
 ///   d(dr)  = dv

@@ -35,7 +35,7 @@ void WheelIns::start(const StaticAccumulator& stat, double vehicle_heading, doub
   s.p_IinW = C_VtoW0 * module_.p_inV - C * module_.lever_arm_inB;
   ImuErrors e;
   e.bg = stat.mean_omega() - C.transpose() * mech_.omega_ie_inW;
-  ekf_.initialize(s, e, ProcessNoise::from(module_.noise), opt_.init, mech_);
+  ekf_.initialize(s, e, module_.noise, opt_.init, mech_);
   window_count_ = window_pos_ = 0;
   window_sum_ = 0.0;
 }
