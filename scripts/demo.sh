@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The demo behind `make demo`: simulate the built-in default scenario (field
-# error profile), then navigate it with each of the paper's configurations and
-# compare them against the truth.
+# The demo behind `make demo`: simulate the built-in default scenario (field error
+# profile, 3 IMU modules x 4 chips), then run the paper's experiment on it: every
+# configuration and chip combination, Tables 4-8 and the plots.
 set -euo pipefail
 bin=${1:-build/wheelins}
 dir=${2:-out/demo}
@@ -9,12 +9,11 @@ dir=${2:-out/demo}
 echo "== simulating the default scenario into $dir/data"
 "$bin" simulate --out "$dir/data" --force
 
-for cfg in single dual-wheel body-wheel triple; do
-  echo
-  echo "== $cfg"
-  "$bin" run --manifest "$dir/data/manifest.yaml" --configuration "$cfg" \
-    --out "$dir/$cfg" --force --quiet
-done
+echo
+echo "== the paper's experiment (64 runs on all cores; a few minutes)"
+"$bin" experiment "$dir/data" --out "$dir/experiment" --force --jobs "$(nproc 2>/dev/null || echo 2)"
 
 echo
-echo "trajectories (CSV, TUM, KML) are in $dir/<configuration>/"
+echo "tables: $dir/experiment/experiment.md (also runs.csv, experiment.json)"
+echo "plots:  $dir/experiment/plots/*.png"
+echo "one configuration with its trajectory files: $bin run -m $dir/data/manifest.yaml -c triple -o $dir/triple"
