@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang (+ AddressSanitizer and UBSan) and runs
+# each for SECONDS (default 60), starting from the seed corpora in fuzz/corpus.
+# A crash, leak, sanitizer report or uncaught exception fails the script.
+# Usage: scripts/fuzz.sh [SECONDS] [BUILD_DIR]
+set -euo pipefail
+seconds=${1:-60}
+build=${2:-build-fuzz}
+cd "$(dirname "$0")/.."
+CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_FUZZ=ON \
+  -DWHEELINS_BUILD_TESTS=OFF -DWHEELINS_BUILD_BENCH=OFF > /dev/null
+cmake --build "$build" -j"$(nproc)" --target fuzz_imu_file fuzz_truth fuzz_config
+for target in imu_file truth config; do
+  corpus_seed="fuzz/corpus/${target%_file}"
+  work="$build/corpus-$target"
+  mkdir -p "$work"
+  echo "== fuzz_$target for ${seconds} s"
+  "$build/fuzz_$target" -max_total_time="$seconds" -print_final_stats=1 -max_len=4096 \
+    -artifact_prefix="$build/crash-$target-" "$work" "$corpus_seed" 2>&1 |
+    grep -E "stat::number_of_executed_units|stat::new_units_added|ERROR|SUMMARY|Done" || true
+  if ls "$build"/crash-"$target"-* > /dev/null 2>&1; then
+    echo "fuzz_$target: crash artifacts in $build" >&2
+    exit 1
+  fi
+done

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Builds the test suite with AddressSanitizer + UndefinedBehaviorSanitizer (gcc)
+# and runs it; any sanitizer report fails a test and so this script.
+# Usage: scripts/sanitize-test.sh [BUILD_DIR]
+set -euo pipefail
+build=${1:-build-asan}
+cd "$(dirname "$0")/.."
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_WERROR=ON \
+  -DWHEELINS_BUILD_BENCH=OFF \
+  -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
+  > /dev/null
+cmake --build "$build" -j"$(nproc)"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+ctest --test-dir "$build" -j"$(nproc)" --output-on-failure
