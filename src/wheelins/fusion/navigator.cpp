@@ -80,6 +80,7 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
       throw InputError("fusion weights must be >= 0 with a positive sum");
   for (double& w : weights_) w /= wsum;
   static_.resize(subs_.size());
+  rp_models_.resize(subs_.size());
 }
 
 Navigator::~Navigator() = default;
@@ -251,12 +252,11 @@ void Navigator::position_update() {
     return;
   }
   // Algorithm 1: o in every subsystem's frame, their weighted mean as the measurement.
-  std::vector<ReferencePointModel> models;
-  models.reserve(subs_.size());
+  std::vector<ReferencePointModel>& models = rp_models_;
   Vec3 fused = Vec3::Zero();
   for (std::size_t i = 0; i < subs_.size(); ++i) {
-    models.push_back(reference_point_model(subs_[i]->reference_point_input()));
-    fused += weights_[i] * models.back().r_o;
+    models[i] = reference_point_model(subs_[i]->reference_point_input());
+    fused += weights_[i] * models[i].r_o;
   }
   const double sd = opt_.fusion.position_std;
   const Mat3 R = Mat3::Identity() * sd * sd;

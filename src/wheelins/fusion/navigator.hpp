@@ -117,6 +117,7 @@ class Navigator {
   BodyIns* body_ = nullptr;
   std::vector<double> weights_;
   std::vector<StaticAccumulator> static_;
+  std::vector<ReferencePointModel> rp_models_;  ///< scratch of position_update(), sized once
   std::unique_ptr<JointCovariance> joint_;
   bool navigating_ = false;
   double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
