@@ -554,6 +554,27 @@ ImuNoise datasheet_noise() {
   n.gyro_bias_tau = n.acc_bias_tau = n.gyro_sf_tau = n.acc_sf_tau = 3600.0;
   return n;
 }
+
+/// One manifest module of group `group` with the given geometry and rolling radius
+/// (the chip manifest states the calibrated geometry, the ideal manifest the truth).
+ModuleSpec module_spec(const ModuleGeometry& geo, double radius, const std::string& name,
+                       const std::string& group, const std::string& chip, const fs::path& file,
+                       double rate_hz) {
+  ModuleSpec s;
+  s.name = name;
+  s.kind = geo.wheel ? ModuleKind::kWheel : ModuleKind::kBody;
+  s.group = group;
+  s.chip = chip;
+  s.file = file;
+  s.rate_hz = rate_hz;
+  s.p_inV = geo.p_inV;
+  s.lever_arm_inB = geo.wheel ? geo.lever_arm_inB : Vec3::Zero();
+  s.mounting_rpy = geo.mounting_rpy;
+  s.axle_sign = 1;
+  s.wheel_radius = geo.wheel ? radius : 0.0;
+  s.noise = datasheet_noise();
+  return s;
+}
 }  // namespace
 
 Manifest Simulation::manifest() const {
@@ -563,20 +584,10 @@ Manifest Simulation::manifest() const {
   for (int g = 0; g < kGroups; ++g) {
     const ModuleModel& mm = modules_[g];
     for (const ChipModel& ch : chips_[g]) {
-      ModuleSpec s;
-      s.name = ch.name;
-      s.kind = mm.truth.wheel ? ModuleKind::kWheel : ModuleKind::kBody;
-      s.group = group_name(g);
-      s.chip = ch.name.substr(ch.name.find('-') + 1);
-      s.file = fs::path(group_dir(g)) / ("tri_" + s.chip + "_imu.bin");
-      s.rate_hz = cfg_.rate_hz;
-      s.p_inV = mm.manifest.p_inV;
-      s.lever_arm_inB = mm.truth.wheel ? mm.manifest.lever_arm_inB : Vec3::Zero();
-      s.mounting_rpy = mm.manifest.mounting_rpy;
-      s.axle_sign = 1;
-      s.wheel_radius = mm.truth.wheel ? mm.radius_manifest : 0.0;
-      s.noise = datasheet_noise();
-      m.modules.push_back(s);
+      const std::string chip = ch.name.substr(ch.name.find('-') + 1);
+      m.modules.push_back(module_spec(mm.manifest, mm.radius_manifest, ch.name, group_name(g), chip,
+                                      fs::path(group_dir(g)) / ("tri_" + chip + "_imu.bin"),
+                                      cfg_.rate_hz));
     }
   }
   return m;
@@ -598,20 +609,10 @@ Manifest Simulation::ideal_manifest() const {
   m.track_width = cfg_.vehicle.track;
   for (int g = 0; g < kGroups; ++g) {
     const ModuleModel& mm = modules_[g];
-    ModuleSpec s;
-    s.name = std::string(g == 0 ? "left" : g == 1 ? "right" : "body") + "-ideal";
-    s.kind = mm.truth.wheel ? ModuleKind::kWheel : ModuleKind::kBody;
-    s.group = group_name(g);
-    s.chip = "ideal";
-    s.file = fs::path("ideal") / (std::string(group_name(g)) + "_imu.bin");
-    s.rate_hz = cfg_.rate_hz;
-    s.p_inV = mm.truth.p_inV;
-    s.lever_arm_inB = mm.truth.wheel ? mm.truth.lever_arm_inB : Vec3::Zero();
-    s.mounting_rpy = mm.truth.mounting_rpy;
-    s.axle_sign = 1;
-    s.wheel_radius = mm.truth.wheel ? mm.radius : 0.0;
-    s.noise = datasheet_noise();
-    m.modules.push_back(s);
+    m.modules.push_back(module_spec(
+        mm.truth, mm.radius, std::string(g == 0 ? "left" : g == 1 ? "right" : "body") + "-ideal",
+        group_name(g), "ideal", fs::path("ideal") / (std::string(group_name(g)) + "_imu.bin"),
+        cfg_.rate_hz));
   }
   return m;
 }
