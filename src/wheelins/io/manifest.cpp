@@ -110,7 +110,7 @@ const std::vector<std::string> kVehicleKeys = {"track_m"};
 const std::vector<std::string> kModuleKeys = {
     "name",          "kind",          "group",        "chip",      "file",
     "format",        "layout",        "rate_hz",      "time_offset_s", "position_v_m",
-    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "wheel_radius_m", "noise"};
+    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "wheel_radius_m", "gyro_range_dps", "noise"};
 
 /// One noise key: its name, its unit factor and the ImuNoise member it fills.
 struct NoiseKey {
@@ -314,6 +314,11 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
   } else if (s.kind == ModuleKind::kWheel) {
     fail(path, "missing required key 'wheel_radius_m' (every wheel module needs its wheel radius)", &n);
   }
+  if (auto v = get(n, "gyro_range_dps"); v.IsDefined()) {
+    const std::string p = join(path, "gyro_range_dps");
+    positive(number(v, p), p, v, "a gyro measurement range");
+    s.gyro_range = number(v, p, kDegU);
+  }
   if (auto v = get(n, "noise"); v.IsDefined()) noise(v, join(path, "noise"), s.noise);
   return s;
 }
@@ -471,6 +476,9 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
              "+1: b x-axis points right, -1: left");
     if (wheel || s.wheel_radius != 0.0)
       w.line(4, "wheel_radius_m: " + num(s.wheel_radius), p + "wheel_radius_m");
+    if (s.gyro_range > 0.0)
+      w.line(4, "gyro_range_dps: " + num(s.gyro_range, kDegU), p + "gyro_range_dps",
+             "full scale: readings at it are saturated");
     w.line(4, "noise:", p + "noise");
     for (const auto& k : kNoiseKeys)
       w.line(6, std::string(k.key) + ": " + num(s.noise.*k.member, k.unit), p + "noise." + k.key);

@@ -55,6 +55,8 @@ struct ModuleSpec {
   Vec3 mounting_rpy = Vec3::Zero();
   int axle_sign = 1;            ///< Wheel-IMU: +1 if b x-axis points right, -1 if left
   double wheel_radius = 0.0;    ///< Wheel-IMU nominal wheel radius [m]
+  /// Gyro full scale [rad/s] (readings at it are saturated); 0 = not stated.
+  double gyro_range = 0.0;
   ImuNoise noise;
 };
 
