@@ -34,6 +34,7 @@ struct RunArgs {
   std::string speed;
   bool centralized = false;
   bool no_constraint = false;
+  bool no_faults = false;
   bool force = false;
   bool quiet = false;
   double duration = 0.0;
@@ -58,6 +59,7 @@ int run(const RunArgs& a) {
   if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
   if (a.force) cfg.overwrite = true;
   if (a.duration > 0) cfg.max_duration = a.duration;
+  if (a.no_faults) cfg.nav.faults.enabled = false;
   if (a.output_interval >= 0) cfg.nav.output_interval = a.output_interval;
 
   RunRequest req = make_run_request(cfg, stderr_sink());
@@ -94,6 +96,7 @@ int run(const RunArgs& a) {
     std::printf("position-constraint updates: %llu (%llu rejected, max test ratio %.2f)\n",
                 static_cast<unsigned long long>(st.position_updates),
                 static_cast<unsigned long long>(st.position_rejected), st.max_position_test_ratio);
+  if (req.nav.faults.enabled) std::cout << res.fault_report;
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
 
   if (req.manifest.truth_file) {
@@ -127,6 +130,9 @@ const bool registered = cli::register_command(
       sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
       sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
+      sub.add_flag("--no-fault-handling", a->no_faults,
+                   "Use every sample and module as it comes (no outage, saturation, slip or "
+                   "fault isolation)");
       sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
       sub.add_option("--output-interval", a->output_interval, "Output interval [s]; 0 = every epoch");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");

@@ -1,6 +1,8 @@
 #include "wheelins/fusion/navigator.hpp"
 
 #include <chrono>
+#include <cstdio>
+#include <limits>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -31,6 +33,7 @@ std::string NavigatorOptions::describe() const {
                                                                        : "classic two-sample")
     << "\n"
     << "earth rotation:             " << (earth_rotation ? "compensated" : "ignored") << "\n"
+    << faults.describe()
     << "output interval:            "
     << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
     << "\n";
@@ -79,22 +82,36 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
     if (!(w >= 0.0) || !(wsum > 0.0))
       throw InputError("fusion weights must be >= 0 with a positive sum");
   for (double& w : weights_) w /= wsum;
+  if (subs_.size() > static_cast<std::size_t>(kMaxModules))
+    throw InputError(std::to_string(subs_.size()) + " modules selected; at most " +
+                     std::to_string(kMaxModules) + " can be fused");
   static_.resize(subs_.size());
   rp_models_.resize(subs_.size());
+  std::vector<std::string> names;
+  for (const auto& sub : subs_) names.push_back(sub->module().name);
+  faults_ = FaultMonitor(std::move(names), opt_.faults);
+  rt_.resize(subs_.size());
 }
 
 Navigator::~Navigator() = default;
 
 double Navigator::min_time() const {
-  double t = subs_[0]->time();
-  for (const auto& s : subs_) t = std::min(t, s->time());
+  double t = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < subsystem_count(); ++i)
+    if (in_use(i)) t = std::min(t, subs_[i]->time());
   return t;
+}
+
+int Navigator::output_driver() const {
+  for (int i = 0; i < subsystem_count(); ++i)
+    if (in_use(i)) return i;
+  return -1;
 }
 
 void Navigator::process(int index, const ImuSample& raw) {
   ++stats_.samples;
   Subsystem& s = *subs_[index];
-  const ImuSample b = s.to_body(raw);
+  ImuSample b = s.to_body(raw);
   if (!navigating_) {
     if (raw.t <= manifest_.static_start) return;
     if (raw.t <= manifest_.static_end + 1e-9) {
@@ -103,10 +120,32 @@ void Navigator::process(int index, const ImuSample& raw) {
     }
     start_navigation(manifest_.static_end);
   }
+  if (opt_.faults.enabled) {
+    Runtime& rt = rt_[index];
+    watch_outages(index, raw.t);
+    if (faults_.health(index) == Health::kOut || raw.dt > opt_.faults.max_gap) {
+      // The data come back (or jump): this sample's interval is unknown motion. Re-level
+      // on the next samples, then restart from the others.
+      char what[160];
+      std::snprintf(what, sizeof what, "data again after a gap of %.3f s", raw.t - rt.last_t);
+      ++faults_.stats(index).gaps;
+      rt.last_t = raw.t;
+      begin_realign(index, raw.t, what,
+                    "re-levelling on its next samples, then restarting from the others");
+      return;
+    }
+    rt.last_t = raw.t;
+    if (faults_.health(index) == Health::kRealign) {
+      rt.realign.add(b);
+      if (rt.realign.duration() + 1e-9 >= opt_.faults.realign_time) restart(index, raw.t);
+      return;
+    }
+    if (s.is_wheel() && s.module().gyro_range > 0.0) handle_saturation(index, raw, b);
+  }
   s.propagate(b);
   if (joint_) joint_->propagate(index, s.ekf().last_dynamics(), s.ekf().noise(), b.dt);
 
-  // Updates when every subsystem has reached the scheduled time.
+  // Updates when every subsystem in use has reached the scheduled time.
   const double t_all = min_time();
   using Clock = std::chrono::steady_clock;
   if (t_all + 1e-9 >= next_velocity_t_) {
@@ -125,13 +164,14 @@ void Navigator::process(int index, const ImuSample& raw) {
       next_position_t_ += opt_.fusion.position_update_interval;
   }
 
-  if (index != 0) return;
+  if (index != output_driver()) return;
   ++stats_.epochs;
   stats_.t_end = raw.t;
   if (raw.t + 1e-9 >= next_output_t_) {
     sink_(0, vehicle_record());
     if (subs_.size() > 1)
-      for (int i = 0; i < subsystem_count(); ++i) sink_(i + 1, subsystem_record(i));
+      for (int i = 0; i < subsystem_count(); ++i)
+        if (in_use(i)) sink_(i + 1, subsystem_record(i));
     ++stats_.records;
     if (opt_.output_interval > 0)
       while (next_output_t_ <= raw.t + 1e-9) next_output_t_ += opt_.output_interval;
@@ -147,6 +187,7 @@ void Navigator::start_navigation(double t0) {
                        std::to_string(manifest_.static_end) +
                        "] s: the alignment needs a static period covered by the data");
     subs_[i]->start(static_[i], manifest_.initial_heading, t0);
+    rt_[i].last_t = t0;
   }
   if (opt_.fusion.centralized && subs_.size() > 1) {
     joint_ = make_joint_covariance(subsystem_count());
@@ -163,40 +204,128 @@ void Navigator::start_navigation(double t0) {
 }
 
 void Navigator::velocity_updates() {
+  const bool handle = opt_.faults.enabled;
+  const double t_now = min_time();
+  if (handle) fault_housekeeping(t_now);
   // Shared information (Section III): vehicle level from the Body-INS, wheel speed.
   if (body_ && opt_.fusion.share_level) {
-    const Vec3 rpy = body_->vehicle_rpy();
-    for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
+    int b = 0;
+    while (subs_[b].get() != body_) ++b;
+    if (counted(b)) {
+      const Vec3 rpy = body_->vehicle_rpy();
+      for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
+    }
   }
-  const double n = static_cast<double>(wheels_.size());
+  // Which wheel speeds can be used: not saturated, and (fault handling on) agreeing with
+  // the wheel's own INS to within speed_gate sigma of the predicted forward velocity.
+  const int n_sub = subsystem_count();
+  std::array<bool, kMaxModules> speed_ok{};
+  std::array<WheelVelocityInput, kMaxModules> own;
+  int n_mean = 0;
   double mean_speed = 0.0;
   Vec3 mean_point = Vec3::Zero();
-  for (WheelIns* w : wheels_) {
-    mean_speed += w->wheel_speed() / n;
-    mean_point += w->module().p_inV / n;
+  for (int i = 0; i < n_sub; ++i) {
+    if (!subs_[i]->is_wheel() || !in_use(i)) continue;
+    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
+    own[i] = w.own_velocity_input();
+    bool ok = true;
+    if (handle) {
+      Runtime& rt = rt_[i];
+      if (t_now < rt.saturated_until) {
+        ok = false;
+      } else {
+        const WheelVelocityModel m = wheel_velocity_model(own[i]);
+        const Mat21 P = covariance(i);
+        const double s_xx = m.H.row(0) * P * m.H.row(0).transpose() + w.velocity_noise()(0, 0);
+        const double e = m.innovation().x();
+        if (std::abs(e) > opt_.faults.speed_gate * std::sqrt(s_xx)) {
+          ok = false;
+          ++faults_.stats(i).speed_rejected;
+          if (!rt.speed_rejected) {
+            char what[160];
+            std::snprintf(what, sizeof what,
+                          "wheel speed %.3f m/s disagrees with its INS (%.3f m/s, %.1f sigma): "
+                          "slip or a lifted wheel",
+                          own[i].measured_speed, m.z_hat.x(), std::abs(e) / std::sqrt(s_xx));
+            faults_.note(i, t_now, what, "speed not used until it agrees again");
+          }
+        } else if (rt.speed_rejected) {
+          faults_.note(i, t_now, "wheel speed agrees again", "speed used again");
+        }
+        rt.speed_rejected = !ok;
+      }
+    }
+    speed_ok[i] = ok;
+    if (ok && counted(i)) {
+      ++n_mean;
+      mean_speed += own[i].measured_speed;
+      mean_point += w.module().p_inV;
+    }
   }
-  auto count = [&](const UpdateReport& rep) {
+  if (n_mean) {
+    mean_speed /= n_mean;
+    mean_point /= n_mean;
+  }
+  constexpr double kNoSpeedVar = 1e4;  // [m^2/s^2]: a forward row that carries no information
+  auto count = [&](int i, const UpdateReport& rep) {
     ++stats_.velocity_updates;
-    if (!rep.accepted) ++stats_.velocity_rejected;
+    if (!rep.accepted) {
+      ++stats_.velocity_rejected;
+      ++faults_.stats(i).velocity_rejected;
+    }
     stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
+    if (!handle || !faults_.velocity_test(i, rep.test_ratio)) return;
+    // The detector fired: isolate the module if the others can go on without it.
+    char what[200];
+    std::snprintf(what, sizeof what,
+                  "velocity innovations inconsistent: %d of the last %d test ratios over %.1f",
+                  opt_.faults.max_failed, opt_.faults.window, opt_.faults.test_ratio);
+    const int others_ok = faults_.count_ok() - (faults_.counts(i) ? 1 : 0);
+    if (n_sub > 1 && others_ok >= 1 && faults_.tied(i)) {
+      faults_.transition(i, Health::kIsolated, t_now, what,
+                         "isolated: out of the fused solution, the mean speed and the constraint");
+      faults_.clear_tests(i);
+    } else if (!rt_[i].detector_fired) {
+      rt_[i].detector_fired = true;
+      faults_.note(i, t_now, what, "no other module to take over: kept (reported once)");
+    }
   };
-  for (int i = 0; i < subsystem_count(); ++i) {
+  for (int i = 0; i < n_sub; ++i) {
+    if (!in_use(i)) continue;
     if (subs_[i]->is_wheel()) {
       const auto& w = static_cast<const WheelIns&>(*subs_[i]);
-      WheelVelocityInput in = w.own_velocity_input();
-      if (opt_.fusion.speed == SpeedSharing::kMean && wheels_.size() > 1) {
-        // Its own speed enters the mean with weight 1/n.
+      WheelVelocityInput in = own[i];
+      Mat3 R = w.velocity_noise();
+      if (speed_ok[i]) {
+        if (opt_.fusion.speed == SpeedSharing::kMean && n_mean > 1 && counted(i)) {
+          // Its own speed enters the mean with weight 1/n.
+          in.measured_speed = mean_speed;
+          in.dspeed_dbgx /= n_mean;
+          in.dspeed_dsgx /= n_mean;
+        }
+      } else if (n_mean > 0) {
+        // Its own speed is unusable: the others' (independent of its states).
         in.measured_speed = mean_speed;
-        in.dspeed_dbgx /= n;
-        in.dspeed_dsgx /= n;
+        in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+      } else {
+        // No speed at all: the NHC rows only.
+        in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+        R(0, 0) = kNoSpeedVar;
       }
       const WheelVelocityModel m = wheel_velocity_model(in);
-      count(fuse(i, m.H, m.innovation(), w.velocity_noise(), w.velocity_gate()));
+      count(i, fuse(i, m.H, m.innovation(), R, w.velocity_gate()));
     } else {
       // The mean speed of the wheels is the speed of the mean of their centres (o for a
       // symmetric pair; the wheel centre itself for one wheel).
-      const BodyVelocityModel m = body_->velocity_model(mean_speed, mean_point);
-      count(fuse(i, m.H, m.innovation(), body_->velocity_noise(), body_->velocity_gate()));
+      Mat3 R = body_->velocity_noise();
+      double speed = mean_speed;
+      if (n_mean == 0) {
+        speed = body_->ins_speed();
+        R(0, 0) = kNoSpeedVar;
+        mean_point.setZero();
+      }
+      const BodyVelocityModel m = body_->velocity_model(speed, mean_point);
+      count(i, fuse(i, m.H, m.innovation(), R, body_->velocity_gate()));
     }
   }
 }
@@ -212,7 +341,8 @@ UpdateReport Navigator::fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, 
   return rep;
 }
 
-UpdateReport Navigator::fuse_position_centralized(int i, double gate) {
+UpdateReport Navigator::fuse_position_centralized(int i, double gate,
+                                                   const std::array<double, kMaxModules>& k) {
   // dz_i = r_o^i - sum_j k_j r_o^j depends on every subsystem's state:
   // H = (1 - k_i) H_i for block i and -k_j H_j for the others.
   std::array<ReferencePointModel, kMaxCentralized> m;
@@ -221,10 +351,10 @@ UpdateReport Navigator::fuse_position_centralized(int i, double gate) {
   Vec3 fused = Vec3::Zero();
   for (int j = 0; j < subsystem_count(); ++j) {
     m[j] = reference_point_model(subs_[j]->reference_point_input());
-    fused += weights_[j] * m[j].r_o;
+    fused += k[j] * m[j].r_o;
   }
   for (int j = 0; j < subsystem_count(); ++j) {
-    h[j] = ((j == i ? 1.0 : 0.0) - weights_[j]) * m[j].H;
+    h[j] = ((j == i ? 1.0 : 0.0) - k[j]) * m[j].H;
     blocks[j] = &h[j];
   }
   const double sd = opt_.fusion.position_std;
@@ -241,32 +371,49 @@ Mat21 Navigator::covariance(int i) const {
 }
 
 void Navigator::position_update() {
-  if (joint_) {
-    // Sequentially, each re-evaluated at the state the previous one left.
-    for (int i = 0; i < subsystem_count(); ++i) {
-      const UpdateReport rep = fuse_position_centralized(i, opt_.fusion.position_gate);
-      ++stats_.position_updates;
-      if (!rep.accepted) ++stats_.position_rejected;
-      stats_.max_position_test_ratio = std::max(stats_.max_position_test_ratio, rep.test_ratio);
+  // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 9) is the
+  // reference; modules on probation are tied to it without moving it.
+  const int n = subsystem_count();
+  std::array<double, kMaxModules> k{};
+  double ksum = 0.0;
+  int n_ref = 0, n_tied = 0;
+  for (int i = 0; i < n; ++i) {
+    if (counted(i)) {
+      k[i] = weights_[i];
+      ksum += k[i];
+      ++n_ref;
     }
-    return;
+    n_tied += !opt_.faults.enabled || faults_.tied(i);
   }
-  // Algorithm 1: o in every subsystem's frame, their weighted mean as the measurement.
-  std::vector<ReferencePointModel>& models = rp_models_;
-  Vec3 fused = Vec3::Zero();
-  for (std::size_t i = 0; i < subs_.size(); ++i) {
-    models[i] = reference_point_model(subs_[i]->reference_point_input());
-    fused += weights_[i] * models[i].r_o;
-  }
-  const double sd = opt_.fusion.position_std;
-  const Mat3 R = Mat3::Identity() * sd * sd;
-  for (std::size_t i = 0; i < subs_.size(); ++i) {
-    const Vec3 dz = models[i].r_o - fused;
-    const UpdateReport rep =
-        subs_[i]->ekf().update<3>(models[i].H, dz, R, opt_.fusion.position_gate);
+  if (n_ref == 0 || n_tied < 2 || !(ksum > 0.0)) return;
+  for (int i = 0; i < n; ++i) k[i] /= ksum;
+  auto record = [&](const UpdateReport& rep) {
     ++stats_.position_updates;
     if (!rep.accepted) ++stats_.position_rejected;
     stats_.max_position_test_ratio = std::max(stats_.max_position_test_ratio, rep.test_ratio);
+  };
+  auto receives = [&](int i) {
+    // A lone reference module is not constrained by itself.
+    return (!opt_.faults.enabled || faults_.tied(i)) && !(n_ref == 1 && k[i] > 0.0);
+  };
+  if (joint_) {
+    // Sequentially, each re-evaluated at the state the previous one left.
+    for (int i = 0; i < n; ++i)
+      if (receives(i)) record(fuse_position_centralized(i, opt_.fusion.position_gate, k));
+    return;
+  }
+  std::vector<ReferencePointModel>& models = rp_models_;
+  Vec3 fused = Vec3::Zero();
+  for (int i = 0; i < n; ++i) {
+    models[i] = reference_point_model(subs_[i]->reference_point_input());
+    fused += k[i] * models[i].r_o;
+  }
+  const double sd = opt_.fusion.position_std;
+  const Mat3 R = Mat3::Identity() * sd * sd;
+  for (int i = 0; i < n; ++i) {
+    if (!receives(i)) continue;
+    const Vec3 dz = models[i].r_o - fused;
+    record(subs_[i]->ekf().update<3>(models[i].H, dz, R, opt_.fusion.position_gate));
   }
 }
 
@@ -305,16 +452,37 @@ TrajectoryRecord Navigator::subsystem_record(int i) const {
 }
 
 TrajectoryRecord Navigator::vehicle_record() const {
-  TrajectoryRecord r = subsystem_record(0);
-  if (subs_.size() == 1) return r;
+  std::array<bool, kMaxModules> use{};
+  bool any = false;
+  for (int i = 0; i < subsystem_count(); ++i) any |= use[i] = counted(i);
+  if (!any)
+    for (int i = 0; i < subsystem_count(); ++i) use[i] = in_use(i);
+  return fused_record(use);
+}
+
+TrajectoryRecord Navigator::fused_record(const std::array<bool, kMaxModules>& use) const {
+  int first = -1, n_use = 0;
+  double ksum = 0.0;
+  for (int i = 0; i < subsystem_count(); ++i)
+    if (use[i]) {
+      if (first < 0) first = i;
+      ++n_use;
+      ksum += weights_[i];
+    }
+  if (first < 0) first = 0;
+  TrajectoryRecord r = subsystem_record(first);
+  if (subs_.size() == 1 || n_use <= 1) return r;
   // Output as in the paper: the fused reference point and the mean heading. The 1-sigma
   // of a weighted mean is bounded by the weighted mean of the sigmas whatever the
   // correlation between subsystems (Minkowski), which is what is reported.
   Vec3 p = Vec3::Zero(), v = Vec3::Zero(), p_std = Vec3::Zero(), v_std = Vec3::Zero();
   double s = 0.0, c = 0.0, psi_std = 0.0;
+  int body_index = -1;
   for (int i = 0; i < subsystem_count(); ++i) {
+    if (!use[i]) continue;
+    if (subs_[i].get() == body_) body_index = i;
     const TrajectoryRecord ri = subsystem_record(i);
-    const double k = weights_[i];
+    const double k = weights_[i] / ksum;
     p += k * ri.p_inN;
     v += k * ri.v_inN;
     p_std += k * ri.p_std;
@@ -330,11 +498,142 @@ TrajectoryRecord Navigator::vehicle_record() const {
   r.v_std = v_std;
   r.rpy.z() = std::atan2(s, c);
   r.rpy_std.z() = psi_std;
-  if (body_) {
+  if (body_index >= 0) {
     const Vec3 rpy = body_->vehicle_rpy();
     r.rpy.head<2>() = rpy.head<2>();
   }
   return r;
 }
+
+// ------------------------------------------------------------------ fault handling
+
+void Navigator::watch_outages(int index, double t) {
+  for (int j = 0; j < subsystem_count(); ++j) {
+    if (j == index) continue;
+    const Health h = faults_.health(j);
+    if (h == Health::kOut) continue;
+    if (t - rt_[j].last_t > opt_.faults.stale_after) {
+      char what[96];
+      std::snprintf(what, sizeof what, "no data after t=%.3f", rt_[j].last_t);
+      faults_.transition(j, Health::kOut, rt_[j].last_t, what,
+                         "left out of the fusion until its data return");
+    }
+  }
+}
+
+double Navigator::substitute_speed(int wheel_index, const char** source) const {
+  const double t = subs_[wheel_index]->time();
+  double sum = 0.0;
+  int n = 0;
+  for (int j = 0; j < subsystem_count(); ++j)
+    if (j != wheel_index && subs_[j]->is_wheel() && counted(j) && !(t < rt_[j].saturated_until)) {
+      sum += static_cast<const WheelIns&>(*subs_[j]).wheel_speed();
+      ++n;
+    }
+  if (n) {
+    *source = "the other wheels";
+    return sum / n;
+  }
+  for (int j = 0; j < subsystem_count(); ++j)
+    if (subs_[j].get() == body_ && counted(j)) {
+      *source = "the Body-INS";
+      return body_->ins_speed();
+    }
+  *source = "its own INS velocity";
+  return static_cast<const WheelIns&>(*subs_[wheel_index]).ins_speed();
+}
+
+void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b) {
+  const double full = opt_.faults.saturation_margin * subs_[index]->module().gyro_range * raw.dt;
+  if (!(raw.dtheta.cwiseAbs().maxCoeff() >= full)) return;
+  Runtime& rt = rt_[index];
+  ++faults_.stats(index).saturated_samples;
+  const char* source = "";
+  const double v = substitute_speed(index, &source);
+  if (!rt.saturation_reported) {
+    rt.saturation_reported = true;
+    char what[128];
+    std::snprintf(what, sizeof what, "gyro at full scale (%.0f deg/s)",
+                  subs_[index]->module().gyro_range / kDeg);
+    faults_.note(index, raw.t, what,
+                 std::string("wheel rate and speed from ") + source +
+                     "; own speed not used while saturated");
+  }
+  rt.saturated_until = raw.t + opt_.faults.saturation_hold;
+  // The axle rate the wheel must have at that speed replaces the clipped reading (the
+  // estimated bias is added back, as the filter removes it).
+  const auto& w = static_cast<const WheelIns&>(*subs_[index]);
+  b.dtheta.x() = (w.omega_x_at_speed(v) + w.ekf().errors().bg.x()) * b.dt;
+}
+
+void Navigator::fault_housekeeping(double t) {
+  for (int i = 0; i < subsystem_count(); ++i) {
+    Runtime& rt = rt_[i];
+    if (rt.saturation_reported && !(t < rt.saturated_until)) {
+      rt.saturation_reported = false;
+      faults_.note(i, t, "gyro back in range", "own speed used again");
+    }
+    const Health h = faults_.health(i);
+    if (h == Health::kProbation && t - faults_.since(i) >= opt_.faults.probation)
+      faults_.transition(i, Health::kOk, t, "probation passed",
+                         "back in the fused solution");
+    else if (h == Health::kIsolated && t - faults_.since(i) >= opt_.faults.retry_after)
+      begin_realign(i, t, "retry after isolation", "re-levelling, then restarting from the others");
+  }
+}
+
+void Navigator::begin_realign(int i, double t, const std::string& what, const std::string& action) {
+  rt_[i].realign.clear();
+  faults_.transition(i, Health::kRealign, t, what, action);
+}
+
+VehicleFix Navigator::vehicle_fix(int i, double t) const {
+  std::array<bool, kMaxModules> use{};
+  bool any = false;
+  for (int j = 0; j < subsystem_count(); ++j) any |= use[j] = j != i && counted(j);
+  if (!any)
+    for (int j = 0; j < subsystem_count(); ++j) any |= use[j] = j != i && in_use(j);
+  VehicleFix fix;
+  fix.t = t;
+  if (any) {
+    const TrajectoryRecord r = fused_record(use);
+    fix.p_OinW = r.p_inN + r.v_inN * (t - r.t);
+    fix.v_OinW = r.v_inN;
+    fix.heading = r.rpy.z();
+    fix.position_std = r.p_std.norm() + 0.05;
+    fix.heading_std = r.rpy_std.z() + 0.5 * kDeg;
+    return fix;
+  }
+  // Alone: its own solution before the gap, extrapolated at constant velocity; the
+  // uncertainty grows with the distance driven blind.
+  const TrajectoryRecord r = subsystem_record(i);
+  const double blind = (t - r.t) * r.v_inN.norm();
+  fix.p_OinW = r.p_inN + r.v_inN * (t - r.t);
+  fix.v_OinW = r.v_inN;
+  fix.heading = r.rpy.z();
+  fix.position_std = r.p_std.norm() + 0.1 + 0.3 * blind;
+  fix.heading_std = r.rpy_std.z() + 2.0 * kDeg;
+  return fix;
+}
+
+void Navigator::restart(int i, double t) {
+  const VehicleFix fix = vehicle_fix(i, t);
+  subs_[i]->restart(rt_[i].realign.mean_f_now(), fix);
+  if (joint_) joint_->reset(i, subs_[i]->ekf().covariance());
+  faults_.clear_tests(i);
+  ++faults_.stats(i).restarts;
+  rt_[i].detector_fired = false;
+  char what[160];
+  std::snprintf(what, sizeof what, "re-initialised (o within %.2f m, heading within %.2f deg)",
+                fix.position_std, fix.heading_std / kDeg);
+  if (subsystem_count() == 1)
+    faults_.transition(i, Health::kOk, t, what, "navigating again");
+  else
+    faults_.transition(i, Health::kProbation, t, what,
+                       "on probation: tied to the others by the constraint, out of the fused "
+                       "solution");
+}
+
+void Navigator::finish() { faults_.finish(stats_.t_end); }
 
 }  // namespace wheelins

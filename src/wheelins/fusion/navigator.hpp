@@ -20,6 +20,7 @@
 #include "wheelins/filter/body_ins.hpp"
 #include "wheelins/filter/wheel_ins.hpp"
 #include "wheelins/fusion/centralized.hpp"
+#include "wheelins/fusion/fault_monitor.hpp"
 #include "wheelins/io/trajectory.hpp"
 
 namespace wheelins {
@@ -49,6 +50,8 @@ struct NavigatorOptions {
   MechanizationOptions::Method mechanization = MechanizationOptions::Method::kRotationExact;
   /// Compensate the earth rotation (the manifest says whether the data contain it).
   bool earth_rotation = true;
+  /// Sensor-fault handling: outages, saturation, slip, isolation of faulty IMUs.
+  FaultOptions faults;
   /// Output interval [s]; 0 = every epoch of the first module.
   double output_interval = 0.0;
   /// The options in human units (OpenVINS style), one per line.
@@ -75,6 +78,7 @@ struct NavigatorStats {
 
 class Navigator {
  public:
+  static constexpr int kMaxModules = 16;
   /// Receives records: stream 0 is the vehicle (the fused solution), streams 1..N the
   /// subsystems' own solutions (only when N > 1).
   using Sink = std::function<void(int stream, const TrajectoryRecord&)>;
@@ -95,6 +99,10 @@ class Navigator {
   const Subsystem& subsystem(int i) const { return *subs_.at(i); }
   /// The fused vehicle solution now.
   TrajectoryRecord vehicle_record() const;
+  /// Health, counters and the report of detected faults.
+  const FaultMonitor& faults() const { return faults_; }
+  /// Closes the fault statistics at the end of the data.
+  void finish();
 
  private:
   void start_navigation(double t0);
@@ -103,10 +111,33 @@ class Navigator {
   /// Fuses dz = H dx_i + e into subsystem i (distributed) or the joint state (centralized).
   UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
   /// Position constraint of subsystem i in the centralized filter (depends on every state).
-  UpdateReport fuse_position_centralized(int i, double gate);
+  UpdateReport fuse_position_centralized(int i, double gate,
+                                         const std::array<double, kMaxModules>& k);
   Mat21 covariance(int i) const;
   TrajectoryRecord subsystem_record(int i) const;
+  /// Weighted mean of the subsystems in `use` (the paper's output, eq. 9).
+  TrajectoryRecord fused_record(const std::array<bool, kMaxModules>& use) const;
   double min_time() const;
+
+  // Fault handling (fault_monitor.hpp).
+  struct Runtime {
+    double last_t = 0.0;             ///< newest sample seen
+    MotionAccumulator realign;       ///< while kRealign
+    double saturated_until = -1e300; ///< the gyro was at full scale until this time + hold
+    bool saturation_reported = false;
+    bool speed_rejected = false;     ///< in a streak of rejected wheel speeds
+    bool detector_fired = false;     ///< reported once for a lone module
+  };
+  bool in_use(int i) const { return !opt_.faults.enabled || faults_.flowing(i); }
+  bool counted(int i) const { return !opt_.faults.enabled || faults_.counts(i); }
+  int output_driver() const;
+  void watch_outages(int index, double t);
+  void handle_saturation(int index, const ImuSample& raw, ImuSample& b);
+  double substitute_speed(int wheel_index, const char** source) const;
+  void begin_realign(int i, double t, const std::string& what, const std::string& action);
+  void restart(int i, double t);
+  VehicleFix vehicle_fix(int i, double t) const;
+  void fault_housekeeping(double t);
 
   Manifest manifest_;
   NavigatorOptions opt_;
@@ -119,6 +150,8 @@ class Navigator {
   std::vector<StaticAccumulator> static_;
   std::vector<ReferencePointModel> rp_models_;  ///< scratch of position_update(), sized once
   std::unique_ptr<JointCovariance> joint_;
+  FaultMonitor faults_;
+  std::vector<Runtime> rt_;
   bool navigating_ = false;
   double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
   NavigatorStats stats_;

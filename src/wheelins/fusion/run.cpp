@@ -26,6 +26,7 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
   for (TrajectoryFormat f : r.formats) files.push_back(r.output_dir / (std::string("trajectory") + extension(f)));
   if (multi(r))
     for (const auto& m : r.modules) files.push_back(r.output_dir / (m + ".csv"));
+  files.push_back(r.output_dir / "faults.csv");
   return files;
 }
 
@@ -102,9 +103,17 @@ RunResult run_navigation(const RunRequest& r) {
                      std::to_string(r.manifest.static_start) + ", " +
                      std::to_string(r.manifest.static_end) + "] s does: nothing to navigate");
 
+  nav.finish();
   RunResult result;
   for (auto& w : vehicle) w->commit();
   for (auto& w : subsystems) w->commit();
+  if (!r.output_dir.empty()) {
+    AtomicTextFile report(r.output_dir / "faults.csv", r.overwrite);
+    report.write(fault_report_csv(nav.faults()));
+    report.commit();
+  }
+  result.fault_report = fault_report_text(nav.faults());
+  result.fault_events = nav.faults().events();
   result.files = outputs;
   result.stats = nav.stats();
   result.filter_seconds = filter_seconds;
