@@ -556,10 +556,11 @@ ImuNoise datasheet_noise() {
 }
 
 /// One manifest module of group `group` with the given geometry and rolling radius
-/// (the chip manifest states the calibrated geometry, the ideal manifest the truth).
+/// (the chip manifest states the calibrated geometry, the ideal manifest the truth) and the
+/// gyro full scale (0: not stated).
 ModuleSpec module_spec(const ModuleGeometry& geo, double radius, const std::string& name,
                        const std::string& group, const std::string& chip, const fs::path& file,
-                       double rate_hz) {
+                       double rate_hz, double gyro_range) {
   ModuleSpec s;
   s.name = name;
   s.kind = geo.wheel ? ModuleKind::kWheel : ModuleKind::kBody;
@@ -572,10 +573,18 @@ ModuleSpec module_spec(const ModuleGeometry& geo, double radius, const std::stri
   s.mounting_rpy = geo.mounting_rpy;
   s.axle_sign = 1;
   s.wheel_radius = geo.wheel ? radius : 0.0;
+  s.gyro_range = gyro_range;
   s.noise = datasheet_noise();
   return s;
 }
 }  // namespace
+
+double Simulation::gyro_range() const {
+  // The chips' gyro full scale, stated when the saturation effect clips at it. The ideal
+  // manifest states it too: it is a property of the chips (their data saturate there), and a
+  // filter run on the error-free streams then flags the same instants as on the chip data.
+  return cfg_.on("saturation") ? cfg_.errors.gyro_range : 0.0;
+}
 
 Manifest Simulation::manifest() const {
   Manifest m = ideal_manifest();
@@ -587,7 +596,7 @@ Manifest Simulation::manifest() const {
       const std::string chip = ch.name.substr(ch.name.find('-') + 1);
       m.modules.push_back(module_spec(mm.manifest, mm.radius_manifest, ch.name, group_name(g), chip,
                                       fs::path(group_dir(g)) / ("tri_" + chip + "_imu.bin"),
-                                      cfg_.rate_hz));
+                                      cfg_.rate_hz, gyro_range()));
     }
   }
   return m;
@@ -612,7 +621,7 @@ Manifest Simulation::ideal_manifest() const {
     m.modules.push_back(module_spec(
         mm.truth, mm.radius, std::string(g == 0 ? "left" : g == 1 ? "right" : "body") + "-ideal",
         group_name(g), "ideal", fs::path("ideal") / (std::string(group_name(g)) + "_imu.bin"),
-        cfg_.rate_hz));
+        cfg_.rate_hz, gyro_range()));
   }
   return m;
 }

@@ -123,6 +123,9 @@ class Simulation {
   /// The manifests of the dataset (paths relative to the dataset directory).
   Manifest manifest() const;
   Manifest ideal_manifest() const;
+  /// The gyro full scale both manifests state [rad/s]: errors.gyro_range with the saturation
+  /// effect on, else 0 (not stated).
+  double gyro_range() const;
 
   /// Writes the dataset into `dir` (see docs/simulator.md). Refuses a non-empty `dir`
   /// unless `force`. Shows progress on a terminal when `progress`.
