@@ -172,6 +172,7 @@ FaultEvent parse_spec(const std::string& spec, const std::string& prefix) {
   }
   static const char* kFormat = "expected KIND:TARGET:T0[:T1|end][:key=value,...]";
   if (parts.size() < 3) throw fail("", std::string(kFormat) + " (at least kind, target and start)");
+  if (parts.size() > 5) throw fail("", std::string(kFormat) + " (too many ':' fields)");
   RawFault r;
   r.kind = {"kind", parts[0], true};
   r.target = {"target", parts[1], true};
