@@ -96,6 +96,9 @@ int run(const RunArgs& a) {
     std::printf("position-constraint updates: %llu (%llu rejected, max test ratio %.2f)\n",
                 static_cast<unsigned long long>(st.position_updates),
                 static_cast<unsigned long long>(st.position_rejected), st.max_position_test_ratio);
+  std::printf("covariance checks: %llu, not positive definite: %llu, max asymmetry %.1e\n",
+              static_cast<unsigned long long>(st.covariance_checks),
+              static_cast<unsigned long long>(st.covariance_not_pd), st.max_covariance_asymmetry);
   if (req.nav.faults.enabled) std::cout << res.fault_report;
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
 

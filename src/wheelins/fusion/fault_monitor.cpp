@@ -21,6 +21,9 @@ void FaultOptions::validate() const {
   positive(speed_gate, "speed_gate_sigma");
   positive(test_ratio, "test_ratio");
   positive(saturation_hold, "saturation_hold_s");
+  positive(heading_gate, "heading_gate_deg");
+  if (heading_epochs < 1)
+    throw InputError("faults.heading_epochs: must be >= 1, got " + std::to_string(heading_epochs));
   if (!(saturation_margin > 0.0 && saturation_margin <= 1.0))
     throw InputError("faults.saturation_margin: must be in (0, 1], got " +
                      std::to_string(saturation_margin));
@@ -39,7 +42,8 @@ std::string FaultOptions::describe() const {
     << max_gap << " s, realign " << realign_time << " s, probation " << probation << " s\n"
     << "fault detector:             " << max_failed << " of " << window
     << " velocity tests over test ratio " << test_ratio << "; retry after " << retry_after
-    << " s\n"
+    << " s; heading " << heading_gate * 180.0 / 3.14159265358979323846 << " deg off the others for "
+    << heading_epochs << " epochs (3+ modules)\n"
     << "wheel speed check:          " << speed_gate << " sigma; saturation at "
     << saturation_margin * 100 << " % of full scale, held " << saturation_hold << " s\n";
   return o.str();
@@ -167,7 +171,7 @@ std::string fault_report_text(const FaultMonitor& m) {
   for (int i = 0; i < m.size(); ++i) {
     const ModuleFaultStats& s = m.stats(i);
     if (!s.gaps && !s.saturated_samples && !s.speed_rejected && !s.isolations && !s.restarts &&
-        !s.velocity_rejected)
+        !s.velocity_rejected && !(s.seconds_unused > 0.0))
       continue;
     std::snprintf(buf, sizeof buf,
                   "  %-10s gaps %llu, saturated samples %llu, speeds unused %llu, velocity "

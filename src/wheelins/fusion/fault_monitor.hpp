@@ -34,6 +34,8 @@ struct FaultOptions {
   double test_ratio = 10.0;         ///< velocity test ratio counted as failed by the detector
   int window = 20;                  ///< the detector's window of velocity tests (<= 64)
   int max_failed = 15;              ///< failed tests in the window that declare a fault
+  double heading_gate = 5.0 * 3.14159265358979323846 / 180.0;  ///< [rad] vs the others' mean
+  int heading_epochs = 5;           ///< constraint epochs in a row off by more: isolated
   double saturation_margin = 0.995; ///< |gyro| >= margin * full scale is saturated
   double saturation_hold = 0.1;     ///< [s] a saturated wheel's speed stays unused this long after
 

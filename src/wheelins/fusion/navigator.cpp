@@ -151,6 +151,7 @@ void Navigator::process(int index, const ImuSample& raw) {
   if (t_all + 1e-9 >= next_velocity_t_) {
     const auto t0 = Clock::now();
     velocity_updates();
+    check_covariances();
     stats_.velocity_step_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
     ++stats_.velocity_steps;
     while (next_velocity_t_ <= t_all + 1e-9) next_velocity_t_ += opt_.wheel.velocity_update_interval;
@@ -219,7 +220,7 @@ void Navigator::velocity_updates() {
   // Which wheel speeds can be used: not saturated, and (fault handling on) agreeing with
   // the wheel's own INS to within speed_gate sigma of the predicted forward velocity.
   const int n_sub = subsystem_count();
-  std::array<bool, kMaxModules> speed_ok{};
+  std::array<bool, kMaxModules> speed_ok{}, saturated{};
   std::array<WheelVelocityInput, kMaxModules> own;
   int n_mean = 0;
   double mean_speed = 0.0;
@@ -233,6 +234,7 @@ void Navigator::velocity_updates() {
       Runtime& rt = rt_[i];
       if (t_now < rt.saturated_until) {
         ok = false;
+        saturated[i] = true;
       } else {
         const WheelVelocityModel m = wheel_velocity_model(own[i]);
         const Mat21 P = covariance(i);
@@ -262,6 +264,15 @@ void Navigator::velocity_updates() {
       mean_point += w.module().p_inV;
     }
   }
+  if (n_mean == 0)
+    // Every wheel saturated: their clipped speeds (lower bounds) are better than none.
+    for (int i = 0; i < n_sub; ++i)
+      if (saturated[i] && counted(i)) {
+        speed_ok[i] = true;
+        ++n_mean;
+        mean_speed += own[i].measured_speed;
+        mean_point += subs_[i]->module().p_inV;
+      }
   if (n_mean) {
     mean_speed /= n_mean;
     mean_point /= n_mean;
@@ -282,9 +293,7 @@ void Navigator::velocity_updates() {
                   opt_.faults.max_failed, opt_.faults.window, opt_.faults.test_ratio);
     const int others_ok = faults_.count_ok() - (faults_.counts(i) ? 1 : 0);
     if (n_sub > 1 && others_ok >= 1 && faults_.tied(i)) {
-      faults_.transition(i, Health::kIsolated, t_now, what,
-                         "isolated: out of the fused solution, the mean speed and the constraint");
-      faults_.clear_tests(i);
+      isolate(i, t_now, what);
     } else if (!rt_[i].detector_fired) {
       rt_[i].detector_fired = true;
       faults_.note(i, t_now, what, "no other module to take over: kept (reported once)");
@@ -385,6 +394,7 @@ void Navigator::position_update() {
     }
     n_tied += !opt_.faults.enabled || faults_.tied(i);
   }
+  if (opt_.faults.enabled) check_headings(min_time());
   if (n_ref == 0 || n_tied < 2 || !(ksum > 0.0)) return;
   for (int i = 0; i < n; ++i) k[i] /= ksum;
   auto record = [&](const UpdateReport& rep) {
@@ -521,7 +531,9 @@ void Navigator::watch_outages(int index, double t) {
   }
 }
 
-double Navigator::substitute_speed(int wheel_index, const char** source) const {
+bool Navigator::substitute_speed(int wheel_index, double* speed) const {
+  // Only another wheel's gyro measures the speed independently; with every wheel
+  // saturated the clipped readings (a lower bound) are all there is.
   const double t = subs_[wheel_index]->time();
   double sum = 0.0;
   int n = 0;
@@ -530,17 +542,8 @@ double Navigator::substitute_speed(int wheel_index, const char** source) const {
       sum += static_cast<const WheelIns&>(*subs_[j]).wheel_speed();
       ++n;
     }
-  if (n) {
-    *source = "the other wheels";
-    return sum / n;
-  }
-  for (int j = 0; j < subsystem_count(); ++j)
-    if (subs_[j].get() == body_ && counted(j)) {
-      *source = "the Body-INS";
-      return body_->ins_speed();
-    }
-  *source = "its own INS velocity";
-  return static_cast<const WheelIns&>(*subs_[wheel_index]).ins_speed();
+  if (n) *speed = sum / n;
+  return n > 0;
 }
 
 void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b) {
@@ -548,27 +551,38 @@ void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b)
   if (!(raw.dtheta.cwiseAbs().maxCoeff() >= full)) return;
   Runtime& rt = rt_[index];
   ++faults_.stats(index).saturated_samples;
-  const char* source = "";
-  const double v = substitute_speed(index, &source);
+  double v = 0.0;
+  const bool substituted = substitute_speed(index, &v);
   if (!rt.saturation_reported) {
     rt.saturation_reported = true;
     char what[128];
     std::snprintf(what, sizeof what, "gyro at full scale (%.0f deg/s)",
                   subs_[index]->module().gyro_range / kDeg);
     faults_.note(index, raw.t, what,
-                 std::string("wheel rate and speed from ") + source +
-                     "; own speed not used while saturated");
+                 substituted ? "axle rate from the other wheels' speed; own speed not used"
+                             : "no unsaturated wheel: clipped reading kept (speed is a lower "
+                               "bound)");
   }
   rt.saturated_until = raw.t + opt_.faults.saturation_hold;
+  if (!substituted) return;
   // The axle rate the wheel must have at that speed replaces the clipped reading (the
   // estimated bias is added back, as the filter removes it).
+  // The reading says the wheel turns at least at full scale.
   const auto& w = static_cast<const WheelIns&>(*subs_[index]);
-  b.dtheta.x() = (w.omega_x_at_speed(v) + w.ekf().errors().bg.x()) * b.dt;
+  const double floor = subs_[index]->module().gyro_range * subs_[index]->module().wheel_radius;
+  const double v_sub = std::abs(v) >= floor ? v : std::copysign(floor, v);
+  b.dtheta.x() = (w.omega_x_at_speed(v_sub) + w.ekf().errors().bg.x()) * b.dt;
 }
 
 void Navigator::fault_housekeeping(double t) {
   for (int i = 0; i < subsystem_count(); ++i) {
     Runtime& rt = rt_[i];
+    if (faults_.counts(i) && t - rt.snapshot_t >= kSnapshotInterval) {
+      rt.errors_old = rt.have_snapshot ? rt.errors_new : subs_[i]->ekf().errors();
+      rt.errors_new = subs_[i]->ekf().errors();
+      rt.snapshot_t = t;
+      rt.have_snapshot = true;
+    }
     if (rt.saturation_reported && !(t < rt.saturated_until)) {
       rt.saturation_reported = false;
       faults_.note(i, t, "gyro back in range", "own speed used again");
@@ -579,6 +593,47 @@ void Navigator::fault_housekeeping(double t) {
                          "back in the fused solution");
     else if (h == Health::kIsolated && t - faults_.since(i) >= opt_.faults.retry_after)
       begin_realign(i, t, "retry after isolation", "re-levelling, then restarting from the others");
+  }
+}
+
+void Navigator::isolate(int i, double t, const std::string& what) {
+  faults_.transition(i, Health::kIsolated, t, what,
+                     "isolated: out of the fused solution, the mean speed and the constraint");
+  faults_.clear_tests(i);
+  rt_[i].revert_errors = true;
+  rt_[i].heading_fails = 0;
+}
+
+void Navigator::check_headings(double t) {
+  // Vehicle heading of every module in good health against the circular mean of the
+  // others (the attitude the subsystems share, Section III). With three or more, the
+  // one that disagrees most, beyond heading_gate for heading_epochs constraint epochs
+  // in a row, is isolated.
+  const int n = subsystem_count();
+  if (faults_.count_ok() < 3) return;
+  std::array<double, kMaxModules> d{};
+  int worst = -1;
+  for (int i = 0; i < n; ++i) {
+    if (!faults_.counts(i)) continue;
+    double s = 0.0, c = 0.0;
+    for (int j = 0; j < n; ++j)
+      if (j != i && faults_.counts(j)) {
+        s += weights_[j] * std::sin(subs_[j]->vehicle_heading());
+        c += weights_[j] * std::cos(subs_[j]->vehicle_heading());
+      }
+    d[i] = std::abs(wrap_pi(subs_[i]->vehicle_heading() - std::atan2(s, c)));
+    if (worst < 0 || d[i] > d[worst]) worst = i;
+  }
+  for (int i = 0; i < n; ++i) {
+    Runtime& rt = rt_[i];
+    if (i == worst && d[i] > opt_.faults.heading_gate) ++rt.heading_fails;
+    else rt.heading_fails = 0;
+    if (rt.heading_fails >= opt_.faults.heading_epochs) {
+      char what[160];
+      std::snprintf(what, sizeof what, "heading %.1f deg off the others' for %d epochs",
+                    d[i] / kDeg, rt.heading_fails);
+      isolate(i, t, what);
+    }
   }
 }
 
@@ -618,6 +673,12 @@ VehicleFix Navigator::vehicle_fix(int i, double t) const {
 
 void Navigator::restart(int i, double t) {
   const VehicleFix fix = vehicle_fix(i, t);
+  if (rt_[i].revert_errors && rt_[i].have_snapshot) {
+    // The sensor-error estimates learnt while the fault went undetected are not trusted:
+    // back to those of 10-20 s before the detection.
+    subs_[i]->ekf().set_errors(rt_[i].errors_old);
+  }
+  rt_[i].revert_errors = false;
   subs_[i]->restart(rt_[i].realign.mean_f_now(), fix);
   if (joint_) joint_->reset(i, subs_[i]->ekf().covariance());
   faults_.clear_tests(i);
@@ -632,6 +693,20 @@ void Navigator::restart(int i, double t) {
     faults_.transition(i, Health::kProbation, t, what,
                        "on probation: tied to the others by the constraint, out of the fused "
                        "solution");
+}
+
+void Navigator::check_covariances() {
+  for (int i = 0; i < subsystem_count(); ++i) {
+    if (!in_use(i)) continue;
+    const Mat21 P = covariance(i);
+    ++stats_.covariance_checks;
+    const double scale = P.cwiseAbs().maxCoeff();
+    if (scale > 0.0)
+      stats_.max_covariance_asymmetry = std::max(
+          stats_.max_covariance_asymmetry, (P - P.transpose()).cwiseAbs().maxCoeff() / scale);
+    const Eigen::LLT<Mat21> llt(P);
+    if (llt.info() != Eigen::Success || !(scale > 0.0)) ++stats_.covariance_not_pd;
+  }
 }
 
 void Navigator::finish() { faults_.finish(stats_.t_end); }

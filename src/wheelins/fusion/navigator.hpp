@@ -74,6 +74,11 @@ struct NavigatorStats {
   /// their number of occurrences, for the paper's Table 8 [s].
   double velocity_step_seconds = 0.0, position_step_seconds = 0.0;
   std::uint64_t velocity_steps = 0, position_steps = 0;
+  /// Covariance health, checked at every velocity-update step for every subsystem in use:
+  /// checks, failures of the Cholesky test (not positive definite), and the largest
+  /// asymmetry max|P - P^T| / max|P| seen.
+  std::uint64_t covariance_checks = 0, covariance_not_pd = 0;
+  double max_covariance_asymmetry = 0.0;
 };
 
 class Navigator {
@@ -127,13 +132,22 @@ class Navigator {
     bool saturation_reported = false;
     bool speed_rejected = false;     ///< in a streak of rejected wheel speeds
     bool detector_fired = false;     ///< reported once for a lone module
+    int heading_fails = 0;           ///< consecutive constraint epochs off the others' heading
+    ImuErrors errors_new, errors_old;  ///< sensor-error estimates 0-10 s and 10-20 s ago
+    double snapshot_t = -1e300;
+    bool have_snapshot = false;
+    bool revert_errors = false;      ///< restart from errors_old (after an isolation)
   };
+  static constexpr double kSnapshotInterval = 10.0;  ///< [s]
+  void isolate(int i, double t, const std::string& what);
+  void check_headings(double t);
+  void check_covariances();
   bool in_use(int i) const { return !opt_.faults.enabled || faults_.flowing(i); }
   bool counted(int i) const { return !opt_.faults.enabled || faults_.counts(i); }
   int output_driver() const;
   void watch_outages(int index, double t);
   void handle_saturation(int index, const ImuSample& raw, ImuSample& b);
-  double substitute_speed(int wheel_index, const char** source) const;
+  bool substitute_speed(int wheel_index, double* speed) const;
   void begin_realign(int i, double t, const std::string& what, const std::string& action);
   void restart(int i, double t);
   VehicleFix vehicle_fix(int i, double t) const;
