@@ -28,6 +28,7 @@ struct Options {
   std::optional<double> radius, track, rate, terrain, static_s, speed;
   std::optional<int> laps, chips;
   bool no_earth_rotation = false;
+  bool no_ideal = false;
 };
 
 std::vector<std::string> split_commas(const std::vector<std::string>& in) {
@@ -73,6 +74,7 @@ int run(const Options& o) {
   if (o.terrain) cfg.terrain_slope_deg = *o.terrain;
   if (o.static_s) cfg.static_duration = *o.static_s;
   if (o.no_earth_rotation) cfg.earth_rotation = false;
+  if (o.no_ideal) cfg.write_ideal = false;
   for (const auto& f : o.faults) cfg.faults.push_back(sim::parse_fault_spec(f));  // after --config's
   if (!o.only.empty()) cfg.only(split_commas(o.only));
   cfg.disable(split_commas(o.disable));
@@ -130,6 +132,8 @@ const bool registered = wheelins::cli::register_command(
       sub.add_option("--terrain", o->terrain, "smooth terrain with slopes up to this many degrees (0: flat)");
       sub.add_option("--static", o->static_s, "static period at the start [s] (default 30)");
       sub.add_flag("--no-earth-rotation", o->no_earth_rotation, "data without the earth rotation rate");
+      sub.add_flag("--no-ideal", o->no_ideal,
+                   "skip the error-free streams (ideal/, manifest-ideal.yaml): half the disk");
       sub.add_option("--fault", o->faults,
                      "sensor fault (repeatable): KIND:TARGET:T0[:T1|end][:key=value,...], times in s since "
                      "the start of the data (no T1 or 'end': until the end); KIND dropout | gyro-bias-jump "

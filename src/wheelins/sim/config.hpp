@@ -106,6 +106,9 @@ struct SimConfig {
   std::optional<double> duration;  ///< [s] from the start; default: the whole scenario
   double rate_hz = 200.0;
   int chips = 4;
+  /// Also write the error-free streams (ideal/, manifest-ideal.yaml). An output choice,
+  /// not a setting of the data: not in scenario.yaml.
+  bool write_ideal = true;
   double gps_week = 2200;
   bool earth_rotation = true;
   VehicleConfig vehicle = VehicleConfig::preset_named("robot");

@@ -946,7 +946,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
   fs::create_directories(dir, ec);
   if (ec) throw InputError("'" + dir.string() + "': cannot create: " + ec.message());
   for (int g = 0; g < kGroups; ++g) fs::create_directories(dir / group_dir(g));
-  fs::create_directories(dir / "ideal");
+  if (cfg_.write_ideal) fs::create_directories(dir / "ideal");
   fs::create_directories(dir / "errors");
 
   const double t0 = start_time();
@@ -965,7 +965,10 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
       GroupStepper st(*this, g, m.time_offset);
       std::unique_ptr<GroupStepper> ideal;
       if (m.time_offset != 0.0) ideal = std::make_unique<GroupStepper>(*this, g, 0.0);
-      BinaryRowWriter ideal_out(dir / "ideal" / (std::string(group_name(g)) + "_imu.bin"), 7);
+      std::unique_ptr<BinaryRowWriter> ideal_out;
+      if (cfg_.write_ideal)
+        ideal_out = std::make_unique<BinaryRowWriter>(
+            dir / "ideal" / (std::string(group_name(g)) + "_imu.bin"), 7);
       std::vector<std::unique_ptr<BinaryRowWriter>> outs, bias_outs;
       std::vector<std::unique_ptr<ChipErrors>> errs;
       std::vector<ChipFaults> faults;
@@ -985,7 +988,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
         else wi = w, fi = f;
         row[0] = b;
         for (int i = 0; i < 3; ++i) row[1 + i] = wi[i], row[4 + i] = fi[i];
-        ideal_out.write(row);
+        if (ideal_out) ideal_out->write(row);
         const double dT = m.temp_rise * (1.0 - std::exp(-(b + m.time_offset - t0) / cfg_.errors.temp_tau));
         // Sample k is at tau = k / rate since the start of the data (fault times).
         const double tau = static_cast<double>(k) / rate;
@@ -1007,7 +1010,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
         }
         if ((k & 255) == 0) done += 256;
       }
-      ideal_out.commit();
+      if (ideal_out) ideal_out->commit();
       for (auto& o : outs) o->commit();
       for (auto& o : bias_outs) o->commit();
     } catch (...) {
@@ -1062,7 +1065,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
   ManifestAnnotations notes;
   notes.header = {"simulated by wheelins simulate; settings in scenario.yaml, drawn errors in errors.yaml",
                   scenario_->describe()};
-  save_manifest(ideal_manifest(), dir / "manifest-ideal.yaml", notes);
+  if (cfg_.write_ideal) save_manifest(ideal_manifest(), dir / "manifest-ideal.yaml", notes);
   save_manifest(manifest(), dir / "manifest.yaml", notes);
 
   DatasetSummary sum;
