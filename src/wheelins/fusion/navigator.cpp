@@ -181,12 +181,16 @@ void Navigator::process(int index, const ImuSample& raw) {
 
 void Navigator::start_navigation(double t0) {
   for (std::size_t i = 0; i < subs_.size(); ++i) {
-    if (static_[i].count() < 10)
-      throw InputError("module '" + subs_[i]->module().name + "': only " +
-                       std::to_string(static_[i].count()) + " samples in the static period [" +
-                       std::to_string(manifest_.static_start) + ", " +
-                       std::to_string(manifest_.static_end) +
-                       "] s: the alignment needs a static period covered by the data");
+    if (static_[i].count() < 10) {
+      char period[96];
+      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", manifest_.static_start,
+                    manifest_.static_end);
+      throw InputError("'" + manifest_.resolve(subs_[i]->module().file).string() + "' (module '" +
+                       subs_[i]->module().name + "'): only " +
+                       std::to_string(static_[i].count()) + " samples in the static period " +
+                       period + " of '" + manifest_.path.string() +
+                       "': the alignment needs the static period covered by every module's data");
+    }
     subs_[i]->start(static_[i], manifest_.initial_heading, t0);
     rt_[i].last_t = t0;
   }

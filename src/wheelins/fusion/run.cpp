@@ -1,6 +1,7 @@
 #include "wheelins/fusion/run.hpp"
 
 #include <chrono>
+#include <cstdio>
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/imu_file.hpp"
@@ -98,10 +99,16 @@ RunResult run_navigation(const RunRequest& r) {
     progress.update(n);
   }
   progress.finish();
-  if (!nav.navigating())
-    throw InputError("the data end before the static period [" +
-                     std::to_string(r.manifest.static_start) + ", " +
-                     std::to_string(r.manifest.static_end) + "] s does: nothing to navigate");
+  if (!nav.navigating()) {
+    char period[96];
+    std::snprintf(period, sizeof period, "[%.3f, %.3f] s", r.manifest.static_start,
+                  r.manifest.static_end);
+    std::string files;
+    for (const auto& name : r.modules)
+      files += (files.empty() ? "'" : ", '") + r.manifest.resolve(r.manifest.find(name)->file).string() + "'";
+    throw InputError(files + ": the data end before the static period " + period + " of '" +
+                     r.manifest.path.string() + "' does: nothing to navigate");
+  }
 
   nav.finish();
   RunResult result;
