@@ -172,6 +172,17 @@ TEST_F(FusionFaults, OutageOfTheFirstModuleIsBridgedAndItIsTakenBack) {
   EXPECT_LT(on.eval.heading_rmse, 1.5 * none.eval.heading_rmse + 0.1 * kDeg);
   EXPECT_GT(off.eval.max_error, 3.0 * on.eval.max_error);
   EXPECT_TRUE(on.covariances_ok);
+
+  // The centralized filter: the restarted module's cross-covariances are reset.
+  NavigatorOptions cent;
+  cent.fusion.centralized = true;
+  const Outcome c_none = run(triple(), {}, true, cent);
+  const Outcome c_on = run(triple(), drop, true, cent);
+  const Outcome c_off = run(triple(), drop, false, cent);
+  print("left-C1 outage 40 s, triple centralized", c_on, c_off, c_none);
+  EXPECT_TRUE(has_event(c_on, "left-C1", "probation passed"));
+  EXPECT_LT(c_on.eval.drift_rate, 1.5 * c_none.eval.drift_rate + 0.0005);
+  EXPECT_LT(c_on.stats.covariance_not_pd, 1u);
 }
 
 TEST_F(FusionFaults, AnImuThatStopsForGoodIsLeftOut) {
