@@ -71,7 +71,11 @@ class FusionFaults : public ::testing::Test {
     traj.has_ned = traj.has_lla = traj.has_heading = traj.has_pos_std = true;
     Outcome out;
     double last_t = -1.0;
+    std::vector<double> last_sub(modules.size() + 1, -1e300);
     Navigator navigator(m, modules, nav, [&](int stream, const TrajectoryRecord& rec) {
+      // Every stream's times must increase (the trajectory writers refuse anything else).
+      EXPECT_GT(rec.t, last_sub[stream]) << "stream " << stream;
+      last_sub[stream] = rec.t;
       if (stream != 0) return;
       if (last_t > 0) out.max_output_gap = std::max(out.max_output_gap, rec.t - last_t);
       last_t = rec.t;

@@ -169,10 +169,16 @@ void Navigator::process(int index, const ImuSample& raw) {
   ++stats_.epochs;
   stats_.t_end = raw.t;
   if (raw.t + 1e-9 >= next_output_t_) {
-    sink_(0, vehicle_record());
+    TrajectoryRecord v = vehicle_record();
+    v.t = raw.t;  // the epoch of the module driving the output
+    sink_(0, v);
     if (subs_.size() > 1)
       for (int i = 0; i < subsystem_count(); ++i)
-        if (in_use(i)) sink_(i + 1, subsystem_record(i));
+        // A module whose data have stopped (not yet declared out) has nothing new.
+        if (in_use(i) && subs_[i]->time() > rt_[i].last_record_t) {
+          rt_[i].last_record_t = subs_[i]->time();
+          sink_(i + 1, subsystem_record(i));
+        }
     ++stats_.records;
     if (opt_.output_interval > 0)
       while (next_output_t_ <= raw.t + 1e-9) next_output_t_ += opt_.output_interval;

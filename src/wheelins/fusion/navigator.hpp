@@ -127,6 +127,7 @@ class Navigator {
   // Fault handling (fault_monitor.hpp).
   struct Runtime {
     double last_t = 0.0;             ///< newest sample seen
+    double last_record_t = -1e300;   ///< time of the last subsystem record written
     MotionAccumulator realign;       ///< while kRealign
     double saturated_until = -1e300; ///< the gyro was at full scale until this time + hold
     bool saturation_reported = false;
