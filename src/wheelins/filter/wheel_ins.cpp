@@ -63,6 +63,13 @@ void WheelIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
   begin(s, ekf_.errors(), init);
 }
 
+double WheelIns::yaw_rate() const {
+  const Mat3 C = ekf_.state().C_ItoW();
+  const Vec3 omega_inW = C * (ekf_.omega_ib_b() - C.transpose() * mech_.omega_ie_inW);
+  const Vec3 axle = C.col(0);
+  return (omega_inW - omega_inW.dot(axle) * axle).z();
+}
+
 double WheelIns::ins_speed() const {
   const NavState& s = ekf_.state();
   const Mat3 C = s.C_ItoW();

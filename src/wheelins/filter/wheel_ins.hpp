@@ -41,6 +41,9 @@ class WheelIns final : public Subsystem {
   double mean_omega_x() const;
   /// The b-frame x rate this wheel turns at when rolling at `speed` [rad/s].
   double omega_x_at_speed(double speed) const { return -axle_sign_ * speed / module_.wheel_radius; }
+  /// Vehicle yaw rate (w-frame z, down: positive turning right) from this gyro less its
+  /// spin about the axle [rad/s].
+  double yaw_rate() const;
   /// Forward speed of the wheel centre from the filter's own velocity [m/s].
   double ins_speed() const;
   /// Its velocity measurement noise covariance (Table 9).

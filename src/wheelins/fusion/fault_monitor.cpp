@@ -19,6 +19,7 @@ void FaultOptions::validate() const {
   positive(probation, "probation_s");
   positive(retry_after, "retry_after_s");
   positive(speed_gate, "speed_gate_sigma");
+  positive(wheel_mismatch, "wheel_mismatch_m_s");
   positive(test_ratio, "test_ratio");
   positive(saturation_hold, "saturation_hold_s");
   positive(heading_gate, "heading_gate_deg");
@@ -44,7 +45,8 @@ std::string FaultOptions::describe() const {
     << " velocity tests over test ratio " << test_ratio << "; retry after " << retry_after
     << " s; heading " << heading_gate * 180.0 / 3.14159265358979323846 << " deg off the others for "
     << heading_epochs << " epochs (3+ modules)\n"
-    << "wheel speed check:          " << speed_gate << " sigma; saturation at "
+    << "wheel speed check:          " << speed_gate << " sigma from its INS and "
+    << wheel_mismatch << " m/s (or 10 %) from the other wheels; saturation at "
     << saturation_margin * 100 << " % of full scale, held " << saturation_hold << " s\n";
   return o.str();
 }

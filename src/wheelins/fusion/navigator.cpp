@@ -1,5 +1,6 @@
 #include "wheelins/fusion/navigator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <limits>
@@ -168,7 +169,9 @@ void Navigator::process(int index, const ImuSample& raw) {
   if (index != output_driver()) return;
   ++stats_.epochs;
   stats_.t_end = raw.t;
-  if (raw.t + 1e-9 >= next_output_t_) {
+  // (raw.t > last: when the driving module changes, the new one may share the epoch.)
+  if (raw.t + 1e-9 >= next_output_t_ && raw.t > last_output_t_) {
+    last_output_t_ = raw.t;
     TrajectoryRecord v = vehicle_record();
     v.t = raw.t;  // the epoch of the module driving the output
     sink_(0, v);
@@ -230,7 +233,7 @@ void Navigator::velocity_updates() {
   // Which wheel speeds can be used: not saturated, and (fault handling on) agreeing with
   // the wheel's own INS to within speed_gate sigma of the predicted forward velocity.
   const int n_sub = subsystem_count();
-  std::array<bool, kMaxModules> speed_ok{}, saturated{};
+  std::array<bool, kMaxModules> speed_ok{}, saturated{}, excused{};
   std::array<WheelVelocityInput, kMaxModules> own;
   int n_mean = 0;
   double mean_speed = 0.0;
@@ -239,43 +242,29 @@ void Navigator::velocity_updates() {
     if (!subs_[i]->is_wheel() || !in_use(i)) continue;
     const auto& w = static_cast<const WheelIns&>(*subs_[i]);
     own[i] = w.own_velocity_input();
-    bool ok = true;
-    if (handle) {
-      Runtime& rt = rt_[i];
-      if (t_now < rt.saturated_until) {
-        ok = false;
-        saturated[i] = true;
-      } else {
-        const WheelVelocityModel m = wheel_velocity_model(own[i]);
-        const Mat21 P = covariance(i);
-        const double s_xx = m.H.row(0) * P * m.H.row(0).transpose() + w.velocity_noise()(0, 0);
-        const double e = m.innovation().x();
-        if (std::abs(e) > opt_.faults.speed_gate * std::sqrt(s_xx)) {
-          ok = false;
-          ++faults_.stats(i).speed_rejected;
-          if (!rt.speed_rejected) {
-            char what[160];
-            std::snprintf(what, sizeof what,
-                          "wheel speed %.3f m/s disagrees with its INS (%.3f m/s, %.1f sigma): "
-                          "slip or a lifted wheel",
-                          own[i].measured_speed, m.z_hat.x(), std::abs(e) / std::sqrt(s_xx));
-            faults_.note(i, t_now, what, "speed not used until it agrees again");
-          }
-        } else if (rt.speed_rejected) {
-          faults_.note(i, t_now, "wheel speed agrees again", "speed used again");
-        }
-        rt.speed_rejected = !ok;
-      }
-    }
-    speed_ok[i] = ok;
-    if (ok && counted(i)) {
+    if (handle && t_now < rt_[i].saturated_until) saturated[i] = true;
+    speed_ok[i] = !saturated[i];
+    // Saturated, or shortly after: its INS is off for a known reason, not a fault.
+    if (handle && t_now - rt_[i].saturated_until < opt_.faults.retry_after) excused[i] = true;
+  }
+  if (handle) check_wheel_speeds(t_now, own, speed_ok);
+  for (int i = 0; i < n_sub; ++i) {
+    if (!subs_[i]->is_wheel() || !in_use(i)) continue;
+    if (speed_ok[i] && counted(i)) {
       ++n_mean;
       mean_speed += own[i].measured_speed;
-      mean_point += w.module().p_inV;
+      mean_point += subs_[i]->module().p_inV;
     }
   }
+  // Every wheel saturated: their clipped speeds (lower bounds) are better than none, and
+  // the innovations they cause are explained: no module is blamed for them.
+  {
+    bool any_excused = false, any_clean = false;
+    for (int i = 0; i < n_sub; ++i)
+      if (subs_[i]->is_wheel() && in_use(i)) (excused[i] ? any_excused : any_clean) = true;
+    degraded_ = any_excused && !any_clean;
+  }
   if (n_mean == 0)
-    // Every wheel saturated: their clipped speeds (lower bounds) are better than none.
     for (int i = 0; i < n_sub; ++i)
       if (saturated[i] && counted(i)) {
         speed_ok[i] = true;
@@ -295,7 +284,8 @@ void Navigator::velocity_updates() {
       ++faults_.stats(i).velocity_rejected;
     }
     stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
-    if (!handle || !faults_.velocity_test(i, rep.test_ratio)) return;
+    if (!handle || excused[i] || degraded_ || !faults_.velocity_test(i, rep.test_ratio))
+      return;
     // The detector fired: isolate the module if the others can go on without it.
     char what[200];
     std::snprintf(what, sizeof what,
@@ -542,14 +532,19 @@ void Navigator::watch_outages(int index, double t) {
 }
 
 bool Navigator::substitute_speed(int wheel_index, double* speed) const {
-  // Only another wheel's gyro measures the speed independently; with every wheel
-  // saturated the clipped readings (a lower bound) are all there is.
+  // Only another wheel's gyro measures the speed independently (one that has not been
+  // saturated for a while: a wheel at the edge of saturation flickers in and out); with
+  // every wheel saturated the clipped readings (a lower bound) are all there is.
   const double t = subs_[wheel_index]->time();
   double sum = 0.0;
   int n = 0;
   for (int j = 0; j < subsystem_count(); ++j)
-    if (j != wheel_index && subs_[j]->is_wheel() && counted(j) && !(t < rt_[j].saturated_until)) {
-      sum += static_cast<const WheelIns&>(*subs_[j]).wheel_speed();
+    if (j != wheel_index && subs_[j]->is_wheel() && counted(j) &&
+        t - rt_[j].saturated_until > kSaturationFree) {
+      // Moved to this wheel: v_i = v_j - yaw_rate (y_i - y_j) (v-frame y to the right).
+      const auto& wj = static_cast<const WheelIns&>(*subs_[j]);
+      sum += wj.wheel_speed() -
+             wj.yaw_rate() * (subs_[wheel_index]->module().p_inV.y() - wj.module().p_inV.y());
       ++n;
     }
   if (n) *speed = sum / n;
@@ -582,6 +577,66 @@ void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b)
   const double floor = subs_[index]->module().gyro_range * subs_[index]->module().wheel_radius;
   const double v_sub = std::abs(v) >= floor ? v : std::copysign(floor, v);
   b.dtheta.x() = (w.omega_x_at_speed(v_sub) + w.ekf().errors().bg.x()) * b.dt;
+}
+
+void Navigator::check_wheel_speeds(double t, const std::array<WheelVelocityInput, kMaxModules>& own,
+                                   std::array<bool, kMaxModules>& speed_ok) {
+  // Slip, a lifted or a locked wheel: its speed disagrees with the other wheels' (moved to
+  // its place with the yaw rate: v_i = v_j - yaw_rate (y_i - y_j), v-frame y to the
+  // right) by more than max(wheel_mismatch, 10 %). The one of a disagreeing set whose
+  // speed is furthest from its own INS (in sigma, and beyond speed_gate) is left out.
+  // A wheel alone is not checked: against its own INS only, slip cannot be told from INS
+  // drift (measured: a 4 s slip with the check on a single Wheel-INS doubled its drift).
+  const int n = subsystem_count();
+  std::array<double, kMaxModules> z{};  // |innovation| / sigma against the own INS
+  int n_u = 0;
+  double yaw_rate = 0.0;
+  for (int i = 0; i < n; ++i) {
+    if (!speed_ok[i] || !subs_[i]->is_wheel()) continue;
+    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
+    const WheelVelocityModel m = wheel_velocity_model(own[i]);
+    const Mat21 P = covariance(i);
+    const double s_xx = m.H.row(0) * P * m.H.row(0).transpose() + w.velocity_noise()(0, 0);
+    z[i] = std::abs(m.innovation().x()) / std::sqrt(s_xx);
+    yaw_rate += w.yaw_rate();
+    ++n_u;
+  }
+  if (n_u < 2) return;
+  yaw_rate /= n_u;
+  int suspect = -1;
+  for (int i = 0; i < n; ++i) {
+    if (!speed_ok[i] || !subs_[i]->is_wheel()) continue;
+    const double vi = own[i].measured_speed, yi = subs_[i]->module().p_inV.y();
+    double pred = 0.0;
+    for (int j = 0; j < n; ++j)
+      if (j != i && speed_ok[j] && subs_[j]->is_wheel())
+        pred += own[j].measured_speed - yaw_rate * (yi - subs_[j]->module().p_inV.y());
+    pred /= n_u - 1;
+    bool disagrees = z[i] > opt_.faults.speed_gate &&
+                     std::abs(vi - pred) > std::max(opt_.faults.wheel_mismatch, 0.1 * std::abs(pred));
+    if (t - rt_[i].saturated_until < opt_.faults.retry_after) disagrees = false;  // INS recovering
+    if (disagrees && (suspect < 0 || z[i] > z[suspect])) suspect = i;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!speed_ok[i] || !subs_[i]->is_wheel()) continue;
+    Runtime& rt = rt_[i];
+    if (i == suspect) {
+      speed_ok[i] = false;
+      ++faults_.stats(i).speed_rejected;
+      if (!rt.speed_rejected) {
+        char what[200];
+        std::snprintf(what, sizeof what,
+                      "wheel speed %.3f m/s disagrees with the other wheels' and its INS (%.1f "
+                      "sigma): slip or a lifted wheel",
+                      own[i].measured_speed, z[i]);
+        faults_.note(i, t, what, "speed not used until it agrees again");
+      }
+      rt.speed_rejected = true;
+    } else if (rt.speed_rejected) {
+      faults_.note(i, t, "wheel speed agrees again", "speed used again");
+      rt.speed_rejected = false;
+    }
+  }
 }
 
 void Navigator::fault_housekeeping(double t) {
@@ -620,7 +675,7 @@ void Navigator::check_headings(double t) {
   // one that disagrees most, beyond heading_gate for heading_epochs constraint epochs
   // in a row, is isolated.
   const int n = subsystem_count();
-  if (faults_.count_ok() < 3) return;
+  if (faults_.count_ok() < 3 || degraded_) return;
   std::array<double, kMaxModules> d{};
   int worst = -1;
   for (int i = 0; i < n; ++i) {

@@ -140,9 +140,12 @@ class Navigator {
     bool revert_errors = false;      ///< restart from errors_old (after an isolation)
   };
   static constexpr double kSnapshotInterval = 10.0;  ///< [s]
+  static constexpr double kSaturationFree = 1.0;     ///< [s] unsaturated before lending its speed
   void isolate(int i, double t, const std::string& what);
   void check_headings(double t);
   void check_covariances();
+  void check_wheel_speeds(double t, const std::array<WheelVelocityInput, kMaxModules>& own,
+                          std::array<bool, kMaxModules>& speed_ok);
   bool in_use(int i) const { return !opt_.faults.enabled || faults_.flowing(i); }
   bool counted(int i) const { return !opt_.faults.enabled || faults_.counts(i); }
   int output_driver() const;
@@ -166,8 +169,10 @@ class Navigator {
   std::vector<ReferencePointModel> rp_models_;  ///< scratch of position_update(), sized once
   std::unique_ptr<JointCovariance> joint_;
   FaultMonitor faults_;
+  bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
   std::vector<Runtime> rt_;
   bool navigating_ = false;
+  double last_output_t_ = -1e300;
   double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
   NavigatorStats stats_;
 };

@@ -155,6 +155,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
         {"probation_s", &FaultOptions::probation, 1.0},
         {"retry_after_s", &FaultOptions::retry_after, 1.0},
         {"speed_gate_sigma", &FaultOptions::speed_gate, 1.0},
+        {"wheel_mismatch_m_s", &FaultOptions::wheel_mismatch, 1.0},
         {"test_ratio", &FaultOptions::test_ratio, 1.0},
         {"heading_gate_deg", &FaultOptions::heading_gate, kDeg},
         {"saturation_margin", &FaultOptions::saturation_margin, 1.0},
