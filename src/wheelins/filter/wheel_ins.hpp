@@ -38,6 +38,11 @@ class WheelIns final : public Subsystem {
   /// This wheel's forward speed from the mean compensated gyro x over the window [m/s].
   double wheel_speed() const;
   double mean_omega_x() const;
+  /// d(wheel_speed) / d(b_g,x) and d / d(s_g,x) of this IMU's residual gyro errors.
+  struct SpeedSensitivity {
+    double dbgx = 0.0, dsgx = 0.0;
+  };
+  SpeedSensitivity speed_sensitivity() const;
   /// Its velocity measurement noise covariance (Table 9).
   Mat3 velocity_noise() const { return opt_.velocity_std.cwiseAbs2().asDiagonal(); }
   double velocity_gate() const { return opt_.gate; }

@@ -63,6 +63,7 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
                          body_->module().name + "' is already selected");
       auto b = std::make_unique<BodyIns>(*m, opt_.body, mech);
       body_ = b.get();
+      body_index_ = static_cast<int>(subs_.size());
       subs_.push_back(std::move(b));
     }
   }
@@ -162,12 +163,137 @@ void Navigator::start_navigation(double t0) {
   next_position_t_ = t0 + opt_.fusion.position_update_interval;
 }
 
-void Navigator::velocity_updates() {
-  // Shared information (Section III): vehicle level from the Body-INS, wheel speed.
+void Navigator::share_level() {
   if (body_ && opt_.fusion.share_level) {
     const Vec3 rpy = body_->vehicle_rpy();
     for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
   }
+}
+
+void Navigator::add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
+                                std::array<H3, kMaxCentralized>& h) const {
+  if (!body_ || !opt_.fusion.share_level || c == 0.0) return;
+  h[body_index_].block<3, 3>(0, PHI) +=
+      c * H_level * vehicle_level_sensitivity(body_->C_VtoW());
+}
+
+void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
+  // The same measurements as the distributed filter (eq. 5 for a Wheel-INS, eq. 6 for the
+  // Body-INS), but one EKF over all error states (Section VI-B-2), so every dependence on
+  // another IMU's state is in H instead of being ignored:
+  //  - the mean wheel speed (1/n) sum_j (-a_j r_j omega_x,j) carries each Wheel-IMU's
+  //    r delta omega_x of eq. (3): -(1/n) dspeed_j/d(b_g,x, s_g,x) in block j (dz = z_hat -
+  //    z_meas); the Body-INS always uses the mean;
+  //  - a Wheel-INS model uses the Body-INS roll/pitch (eq. 5, theta_3 and phi_3): its
+  //    H_level times d(roll, pitch)/d(phi_3) in the Body-INS block.
+  // Everything is evaluated at the current state: the speeds from the current gyro-x
+  // estimates, the level from the current Body-INS attitude.
+  const int N = subsystem_count();
+  const double n = static_cast<double>(wheels_.size());
+  double mean_speed = 0.0;
+  Vec3 mean_point = Vec3::Zero();
+  for (const WheelIns* w : wheels_) {
+    mean_speed += w->wheel_speed() / n;
+    mean_point += w->module().p_inV / n;
+  }
+  for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
+  const bool wheel = subs_[i]->is_wheel();
+  const bool mean = !wheel || (opt_.fusion.speed == SpeedSharing::kMean && n > 1);
+  if (wheel) {
+    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
+    WheelVelocityInput in = w.own_velocity_input();
+    if (body_ && opt_.fusion.share_level) {
+      const Vec3 rpy = body_->vehicle_rpy();
+      in.vehicle_roll = rpy.x();
+      in.vehicle_pitch = rpy.y();
+    }
+    if (mean) {  // the speed's sensitivities are added below, for every wheel
+      in.measured_speed = mean_speed;
+      in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+    }
+    const WheelVelocityModel m = wheel_velocity_model(in);
+    jm.H[i] = m.H;
+    add_level_block(m.H_level, 1.0, jm.H);
+    jm.dz = m.innovation();
+    jm.R = w.velocity_noise();
+    jm.gate = w.velocity_gate();
+  } else {
+    const BodyVelocityModel m = body_->velocity_model(mean_speed, mean_point);
+    jm.H[i] = m.H;
+    jm.dz = m.innovation();
+    jm.R = body_->velocity_noise();
+    jm.gate = body_->velocity_gate();
+  }
+  if (mean)
+    for (int j = 0; j < N; ++j) {
+      if (!subs_[j]->is_wheel()) continue;
+      const WheelIns::SpeedSensitivity ds =
+          static_cast<const WheelIns&>(*subs_[j]).speed_sensitivity();
+      jm.H[j](0, BG) -= ds.dbgx / n;
+      jm.H[j](0, SG) -= ds.dsgx / n;
+    }
+}
+
+void Navigator::position_measurement(int i, JointMeasurement& jm) const {
+  // dz_i = r_o^i - sum_j k_j r_o^j (eq. 9, 12) depends on every subsystem's state:
+  // (1 - k_i) H_i in block i and -k_j H_j in the others, and, through the level a Wheel-INS
+  // uses in C_v^w (eq. 8), on the Body-INS attitude.
+  const int N = subsystem_count();
+  Vec3 level = Vec3::Zero();
+  const bool shared = body_ && opt_.fusion.share_level;
+  if (shared) level = body_->vehicle_rpy();
+  Vec3 fused = Vec3::Zero(), own = Vec3::Zero();
+  for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
+  for (int j = 0; j < N; ++j) {
+    ReferencePointInput in = subs_[j]->reference_point_input();
+    if (shared && in.wheel) {
+      in.vehicle_roll = level.x();
+      in.vehicle_pitch = level.y();
+    }
+    const ReferencePointModel m = reference_point_model(in);
+    const double c = (j == i ? 1.0 : 0.0) - weights_[j];
+    jm.H[j] += c * m.H;
+    if (in.wheel) add_level_block(m.H_level, c, jm.H);
+    fused += weights_[j] * m.r_o;
+    if (j == i) own = m.r_o;
+  }
+  jm.dz = own - fused;
+  const double sd = opt_.fusion.position_std;
+  jm.R = Mat3::Identity() * sd * sd;
+  jm.gate = opt_.fusion.position_gate;
+}
+
+UpdateReport Navigator::fuse_joint(const JointMeasurement& m) {
+  std::array<const H3*, kMaxCentralized> blocks{};
+  for (int j = 0; j < subsystem_count(); ++j) blocks[j] = &m.H[j];
+  std::array<Vec21, kMaxCentralized> dx;
+  const UpdateReport rep = joint_->update(blocks, m.dz, m.R, m.gate, dx);
+  if (rep.accepted)
+    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
+  return rep;
+}
+
+void Navigator::velocity_updates_centralized() {
+  // Sequential updates, each evaluated at the state the previous one left (the joint
+  // correction moves every IMU's errors).
+  JointMeasurement& m = joint_scratch_;
+  for (int i = 0; i < subsystem_count(); ++i) {
+    share_level();
+    velocity_measurement(i, m);
+    const UpdateReport rep = fuse_joint(m);
+    ++stats_.velocity_updates;
+    if (!rep.accepted) ++stats_.velocity_rejected;
+    stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
+  }
+}
+
+void Navigator::velocity_updates() {
+  if (joint_) {
+    velocity_updates_centralized();
+    return;
+  }
+  // Shared information (Section III): vehicle level from the Body-INS, wheel speed.
+  share_level();
   const double n = static_cast<double>(wheels_.size());
   double mean_speed = 0.0;
   Vec3 mean_point = Vec3::Zero();
@@ -212,30 +338,6 @@ UpdateReport Navigator::fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, 
   return rep;
 }
 
-UpdateReport Navigator::fuse_position_centralized(int i, double gate) {
-  // dz_i = r_o^i - sum_j k_j r_o^j depends on every subsystem's state:
-  // H = (1 - k_i) H_i for block i and -k_j H_j for the others.
-  std::array<ReferencePointModel, kMaxCentralized> m;
-  std::array<H3, kMaxCentralized> h;
-  std::array<const H3*, kMaxCentralized> blocks{};
-  Vec3 fused = Vec3::Zero();
-  for (int j = 0; j < subsystem_count(); ++j) {
-    m[j] = reference_point_model(subs_[j]->reference_point_input());
-    fused += weights_[j] * m[j].r_o;
-  }
-  for (int j = 0; j < subsystem_count(); ++j) {
-    h[j] = ((j == i ? 1.0 : 0.0) - weights_[j]) * m[j].H;
-    blocks[j] = &h[j];
-  }
-  const double sd = opt_.fusion.position_std;
-  std::array<Vec21, kMaxCentralized> dx;
-  const UpdateReport rep =
-      joint_->update(blocks, m[i].r_o - fused, Mat3::Identity() * sd * sd, gate, dx);
-  if (rep.accepted)
-    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
-  return rep;
-}
-
 Mat21 Navigator::covariance(int i) const {
   return joint_ ? joint_->block(i) : subs_[i]->ekf().covariance();
 }
@@ -243,8 +345,11 @@ Mat21 Navigator::covariance(int i) const {
 void Navigator::position_update() {
   if (joint_) {
     // Sequentially, each re-evaluated at the state the previous one left.
+    JointMeasurement& m = joint_scratch_;
     for (int i = 0; i < subsystem_count(); ++i) {
-      const UpdateReport rep = fuse_position_centralized(i, opt_.fusion.position_gate);
+      share_level();
+      position_measurement(i, m);
+      const UpdateReport rep = fuse_joint(m);
       ++stats_.position_updates;
       if (!rep.accepted) ++stats_.position_rejected;
       stats_.max_position_test_ratio = std::max(stats_.max_position_test_ratio, rep.test_ratio);

@@ -73,6 +73,14 @@ struct NavigatorStats {
   std::uint64_t velocity_steps = 0, position_steps = 0;
 };
 
+/// One measurement of the centralized filter: dz = sum_j H[j] dx_j + e, e ~ N(0, R).
+struct JointMeasurement {
+  std::array<H3, kMaxCentralized> H;
+  Vec3 dz = Vec3::Zero();
+  Mat3 R = Mat3::Identity();
+  double gate = 0.0;
+};
+
 class Navigator {
  public:
   /// Receives records: stream 0 is the vehicle (the fused solution), streams 1..N the
@@ -93,17 +101,31 @@ class Navigator {
   const NavigatorStats& stats() const { return stats_; }
   int subsystem_count() const { return static_cast<int>(subs_.size()); }
   const Subsystem& subsystem(int i) const { return *subs_.at(i); }
+  Subsystem& subsystem(int i) { return *subs_.at(i); }
+  /// The centralized filter's measurements of subsystem i at the current state (also
+  /// usable without a joint covariance, for checking them): the velocity + NHC update
+  /// (eq. 5/6) and the position constraint (eq. 12), H with a block for every IMU.
+  void velocity_measurement(int i, JointMeasurement& m) const;
+  void position_measurement(int i, JointMeasurement& m) const;
   /// The fused vehicle solution now.
   TrajectoryRecord vehicle_record() const;
 
  private:
   void start_navigation(double t0);
   void velocity_updates();
+  /// The centralized filter's velocity updates: H also carries the other IMUs' blocks.
+  void velocity_updates_centralized();
+  /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
+  void share_level();
+  /// Adds, to the Body-INS block of a joint H, the dependence of a Wheel-INS measurement on
+  /// the shared level: H_level * d(roll, pitch)/d(phi_body), scaled by `c`.
+  void add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
+                       std::array<H3, kMaxCentralized>& h) const;
+  /// Fuses a joint measurement into the joint covariance and feeds every subsystem back.
+  UpdateReport fuse_joint(const JointMeasurement& m);
   void position_update();
   /// Fuses dz = H dx_i + e into subsystem i (distributed) or the joint state (centralized).
   UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
-  /// Position constraint of subsystem i in the centralized filter (depends on every state).
-  UpdateReport fuse_position_centralized(int i, double gate);
   Mat21 covariance(int i) const;
   TrajectoryRecord subsystem_record(int i) const;
   double min_time() const;
@@ -115,10 +137,12 @@ class Navigator {
   std::vector<std::unique_ptr<Subsystem>> subs_;
   std::vector<WheelIns*> wheels_;
   BodyIns* body_ = nullptr;
+  int body_index_ = -1;  ///< position of the Body-INS in subs_
   std::vector<double> weights_;
   std::vector<StaticAccumulator> static_;
   std::vector<ReferencePointModel> rp_models_;  ///< scratch of position_update(), sized once
   std::unique_ptr<JointCovariance> joint_;
+  JointMeasurement joint_scratch_;  ///< of the centralized updates
   bool navigating_ = false;
   double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
   NavigatorStats stats_;
