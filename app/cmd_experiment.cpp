@@ -64,6 +64,13 @@ int run(const Args& a) {
     plots = eval::write_experiment_plots(r, truth, earth::LocalFrame(r.origin), out, a.force, o.warn);
   }
   std::cout << md;
+  std::size_t events = 0, runs_with = 0;
+  for (const auto& x : r.runs) {
+    events += x.fault_events;
+    runs_with += x.fault_events > 0;
+  }
+  std::cout << "fault handling: " << events << " fault events in " << runs_with << " of "
+            << r.runs.size() << " runs (runs.csv, column fault_events)\n";
   for (const auto& f : files) std::cout << "wrote " << f.string() << "\n";
   std::size_t data_files = 0;
   for (const auto& f : plots) {

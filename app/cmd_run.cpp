@@ -34,6 +34,8 @@ struct RunArgs {
   std::string speed;
   bool centralized = false;
   bool no_constraint = false;
+  bool no_faults = false;
+  bool no_evaluate = false;
   bool force = false;
   bool quiet = false;
   double duration = 0.0;
@@ -58,6 +60,7 @@ int run(const RunArgs& a) {
   if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
   if (a.force) cfg.overwrite = true;
   if (a.duration > 0) cfg.max_duration = a.duration;
+  if (a.no_faults) cfg.nav.faults.enabled = false;
   if (a.output_interval >= 0) cfg.nav.output_interval = a.output_interval;
 
   RunRequest req = make_run_request(cfg, stderr_sink());
@@ -67,7 +70,9 @@ int run(const RunArgs& a) {
   TrajectoryData traj;
   traj.has_ned = traj.has_lla = traj.has_heading = traj.has_pos_std = true;
   double next_keep = -1e300;
-  req.on_record = [&](const TrajectoryRecord& r) {
+  // Only when there is something to evaluate against: the kept solution grows with the run.
+  const bool evaluate = req.manifest.truth_file && !a.no_evaluate;
+  if (evaluate) req.on_record = [&](const TrajectoryRecord& r) {
     if (r.t + 1e-9 < next_keep) return;
     traj.records.push_back(r);
     next_keep = r.t + 0.05;
@@ -94,9 +99,13 @@ int run(const RunArgs& a) {
     std::printf("position-constraint updates: %llu (%llu rejected, max test ratio %.2f)\n",
                 static_cast<unsigned long long>(st.position_updates),
                 static_cast<unsigned long long>(st.position_rejected), st.max_position_test_ratio);
+  std::printf("covariance checks: %llu, not positive definite: %llu, max asymmetry %.1e\n",
+              static_cast<unsigned long long>(st.covariance_checks),
+              static_cast<unsigned long long>(st.covariance_not_pd), st.max_covariance_asymmetry);
+  if (req.nav.faults.enabled) std::cout << res.fault_report;
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
 
-  if (req.manifest.truth_file) {
+  if (evaluate) {
     const TruthData truth = read_truth(req.manifest.resolve(*req.manifest.truth_file));
     const eval::EvalResult e = eval::evaluate(truth, traj, earth::LocalFrame(req.manifest.origin));
     std::printf("\nagainst the truth (%s):\n", truth.file.string().c_str());
@@ -127,6 +136,12 @@ const bool registered = cli::register_command(
       sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
       sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
+      sub.add_flag("--no-evaluate", a->no_evaluate,
+                   "Do not evaluate against the manifest's truth (the evaluation holds the truth "
+                   "and the 20 Hz solution in memory; without it memory stays flat)");
+      sub.add_flag("--no-fault-handling", a->no_faults,
+                   "Use every sample and module as it comes (no outage, saturation, slip or "
+                   "fault isolation)");
       sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
       sub.add_option("--output-interval", a->output_interval, "Output interval [s]; 0 = every epoch");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");

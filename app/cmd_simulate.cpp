@@ -23,11 +23,12 @@ struct Options {
   std::string out;
   bool force = false;
   bool quiet = false;
-  std::vector<std::string> disable, only, settings;
+  std::vector<std::string> disable, only, settings, faults;
   std::string config;
   std::optional<double> radius, track, rate, terrain, static_s, speed;
   std::optional<int> laps, chips;
   bool no_earth_rotation = false;
+  bool no_ideal = false;
 };
 
 std::vector<std::string> split_commas(const std::vector<std::string>& in) {
@@ -73,6 +74,8 @@ int run(const Options& o) {
   if (o.terrain) cfg.terrain_slope_deg = *o.terrain;
   if (o.static_s) cfg.static_duration = *o.static_s;
   if (o.no_earth_rotation) cfg.earth_rotation = false;
+  if (o.no_ideal) cfg.write_ideal = false;
+  for (const auto& f : o.faults) cfg.faults.push_back(sim::parse_fault_spec(f));  // after --config's
   if (!o.only.empty()) cfg.only(split_commas(o.only));
   cfg.disable(split_commas(o.disable));
 
@@ -91,6 +94,10 @@ int run(const Options& o) {
                   simulation.speed_scale());
     std::printf("duration  %.1f s (%llu samples at %g Hz), distance %.1f m\n", sum.duration,
                 static_cast<unsigned long long>(sum.imu_rows), cfg.rate_hz, sum.distance);
+    if (simulation.gyro_range() > 0.0)
+      std::printf("gyro      full scale %g deg/s (saturation on)\n", simulation.gyro_range() / kDeg);
+    std::printf("faults    %s\n", cfg.faults.empty() ? "none" : "(times in s since the start of the data)");
+    for (const auto& f : cfg.faults) std::printf("          %s\n", f.spec().c_str());
     std::printf("output    %s: %d files, %.1f MB, written in %.1f s\n", o.out.c_str(), sum.files,
                 sum.bytes / 1e6, sum.seconds);
   }
@@ -125,6 +132,23 @@ const bool registered = wheelins::cli::register_command(
       sub.add_option("--terrain", o->terrain, "smooth terrain with slopes up to this many degrees (0: flat)");
       sub.add_option("--static", o->static_s, "static period at the start [s] (default 30)");
       sub.add_flag("--no-earth-rotation", o->no_earth_rotation, "data without the earth rotation rate");
+      sub.add_flag("--no-ideal", o->no_ideal,
+                   "skip the error-free streams (ideal/, manifest-ideal.yaml): half the disk");
+      sub.add_option("--fault", o->faults,
+                     "sensor fault (repeatable): KIND:TARGET:T0[:T1|end][:key=value,...], times in s since "
+                     "the start of the data (no T1 or 'end': until the end); KIND dropout | gyro-bias-jump "
+                     "(axis=x|y|z,value=DEG_S) | accel-bias-jump (axis,value=M_S2) | stuck "
+                     "(sensor=gyro|accel,axis) | slip (wheel groups; ratio=S: the wheel turns at (1+S) x its "
+                     "rolling rate); TARGET a chip (left-C1) or a group (left-wheel, right-wheel, body)");
+      sub.footer(
+          "Fault examples (docs/simulator.md, \"Sensor faults\"):\n"
+          "  --fault dropout:left-C1:300:360                          no left-C1 samples stamped in [300 s, 360 s)\n"
+          "  --fault dropout:body:500                                 the Body-IMU chips stop at 500 s\n"
+          "  --fault gyro-bias-jump:right-C1:400:end:axis=z,value=0.5 +0.5 deg/s on gyro z from 400 s on\n"
+          "  --fault stuck:body-C1:200:260:sensor=gyro,axis=z         gyro z repeats its last value\n"
+          "  --fault slip:left-wheel:150:155:ratio=0.5                the left wheel spins 50 % too fast\n"
+          "  --fault slip:right-wheel:600:603:ratio=-1                the right wheel is locked\n"
+          "Gyro saturation at robot speeds: --set errors.gyro_range_deg_s=500");
       return [o]() { return run(*o); };
     });
 

@@ -64,6 +64,7 @@ filter:
   wheel_velocity_std_m_s: [0.05, 0.03, 0.03]
   initial_std: {heading_deg: 0.5}
 fusion: {speed: own, position_update_hz: 2, position_std_m: 0.3, centralized: true}
+faults: {heading_gate_deg: 8, window: 30, max_failed: 20, probation_s: 5}
 )");
   std::vector<std::string> warnings;
   const RunConfig c = load_run_config(dir / "run.yaml", [&](const std::string& w) { warnings.push_back(w); });
@@ -81,6 +82,11 @@ fusion: {speed: own, position_update_hz: 2, position_std_m: 0.3, centralized: tr
   EXPECT_DOUBLE_EQ(c.nav.fusion.position_update_interval, 0.5);
   EXPECT_DOUBLE_EQ(c.nav.fusion.position_std, 0.3);
   EXPECT_TRUE(c.nav.fusion.centralized);
+  EXPECT_TRUE(c.nav.faults.enabled);
+  EXPECT_NEAR(c.nav.faults.heading_gate, 8.0 * kDeg, 1e-15);
+  EXPECT_EQ(c.nav.faults.window, 30);
+  EXPECT_EQ(c.nav.faults.max_failed, 20);
+  EXPECT_DOUBLE_EQ(c.nav.faults.probation, 5.0);
 }
 
 TEST(FusionRunConfig, BadValuesNameTheKeyAndLine) {
@@ -99,6 +105,13 @@ TEST(FusionRunConfig, BadValuesNameTheKeyAndLine) {
   EXPECT_NE(e.find("filter.wheel_velocity_std_m_s: must be > 0"), std::string::npos) << e;
   e = load("dataset: m.yaml\nfusion: {speed: fastest}\n");
   EXPECT_NE(e.find("fusion.speed: expected mean or own"), std::string::npos) << e;
+  e = load("dataset: m.yaml\nfaults:\n  window: 10\n  max_failed: 12\n");
+  EXPECT_NE(e.find("faults.max_failed: must be 1..window (10), got 12"), std::string::npos) << e;
+  e = load("dataset: m.yaml\nfaults:\n  enabled: maybe\n");
+  EXPECT_NE(e.find("faults.enabled"), std::string::npos) << e;
+  EXPECT_NE(e.find("line 3"), std::string::npos) << e;
+  e = load("dataset: m.yaml\nfaults:\n  window: 2.5\n");
+  EXPECT_NE(e.find("faults.window: must be a whole number"), std::string::npos) << e;
   e = load("dataset: [unclosed\n");
   EXPECT_NE(e.find("malformed YAML"), std::string::npos) << e;
   e = error_of([&] { load_run_config(dir / "missing.yaml", {}); });

@@ -165,7 +165,7 @@ TEST_F(NavEndToEnd, RunWritesFilesAndNeverOverwritesUnasked) {
   r.progress = false;
   r.max_duration = 20.0;
   const RunResult first = run_navigation(r);
-  ASSERT_EQ(first.files.size(), 5u);  // csv, tum, kml + one csv per subsystem
+  ASSERT_EQ(first.files.size(), 6u);  // csv, tum, kml + one csv per subsystem + faults.csv
   for (const auto& f : first.files) EXPECT_TRUE(fs::exists(f)) << f;
   const auto size = fs::file_size(out / "trajectory.csv");
   try {

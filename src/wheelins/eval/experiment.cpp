@@ -163,6 +163,7 @@ ExperimentResult run_experiment(const fs::path& manifest_file, const ExperimentO
         req.on_record = [&](const TrajectoryRecord& r) { traj.records.push_back(r); };
         const RunResult rr = run_navigation(req);
         run.stats = rr.stats;
+        run.fault_events = rr.fault_events.size();
         run.filter_seconds = rr.filter_seconds;
         run.eval = evaluate(truth, traj, frame);
         // Keep a 10 Hz error series for the figures only.
@@ -318,7 +319,7 @@ std::string experiment_csv(const ExperimentResult& r) {
   std::ostringstream o;
   o << "configuration,filter,chips,modules,drift_rate_pct,heading_rmse_deg,max_error_m,final_error_m,"
        "distance_m,within_3sigma_pct,mean_nees,epochs,filter_seconds,us_per_epoch,"
-       "velocity_update_us,position_update_us\n";
+       "velocity_update_us,position_update_us,fault_events\n";
   for (const auto& x : r.runs) {
     std::string mods;
     for (const auto& m : x.modules) mods += (mods.empty() ? "" : "+") + m;
@@ -330,7 +331,8 @@ std::string experiment_csv(const ExperimentResult& r) {
       << fmt(x.eval.mean_nees, 3) << "," << s.epochs << "," << fmt(x.filter_seconds, 4) << ","
       << fmt(s.epochs ? 1e6 * x.filter_seconds / s.epochs : NAN, 3) << ","
       << fmt(s.velocity_steps ? 1e6 * s.velocity_step_seconds / s.velocity_steps : NAN, 3) << ","
-      << fmt(s.position_steps ? 1e6 * s.position_step_seconds / s.position_steps : NAN, 3) << "\n";
+      << fmt(s.position_steps ? 1e6 * s.position_step_seconds / s.position_steps : NAN, 3) << ","
+      << x.fault_events << "\n";
   }
   return o.str();
 }
@@ -346,6 +348,7 @@ std::string experiment_json(const ExperimentResult& r) {
       << "\", \"modules\": [";
     for (std::size_t k = 0; k < x.modules.size(); ++k) o << (k ? ", " : "") << "\"" << x.modules[k] << "\"";
     o << "], \"filter_seconds\": " << fmt(x.filter_seconds, 4) << ", \"epochs\": " << x.stats.epochs
+      << ", \"fault_events\": " << x.fault_events
       << ", \"evaluation\": " << to_json(x.eval) << "}" << (i + 1 < r.runs.size() ? "," : "") << "\n";
   }
   o << "  ]\n}\n";

@@ -19,6 +19,7 @@
 namespace wheelins::eval {
 
 struct ExperimentOptions {
+  // (the navigator options below include the fault handling; on by default)
   NavigatorOptions nav;           ///< filter settings shared by every run
   int jobs = 2;                   ///< runs in parallel
   double duration = 0.0;          ///< navigation per run [s]; 0 = all data
@@ -39,6 +40,7 @@ struct ExperimentRun {
   EvalResult eval;                   ///< series (10 Hz) kept only for figure runs
   std::vector<TrajectoryRecord> track;  ///< 1 Hz vehicle solution, figure runs only
   NavigatorStats stats;
+  std::size_t fault_events = 0;      ///< lines of the run's fault report (0 on clean data)
   double filter_seconds = 0.0;
   bool figure = false;  ///< a Fig. 7-9 run (paper chips or closest, see experiment_plan)
 };

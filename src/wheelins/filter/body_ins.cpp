@@ -19,6 +19,21 @@ void BodyIns::start(const StaticAccumulator& stat, double vehicle_heading, doubl
   ekf_.initialize(s, e, module_.noise, opt_.init, mech_);
 }
 
+void BodyIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
+  NavState s;
+  s.t = fix.t;
+  const Mat3 C = align_attitude(mean_f_inB, fix.heading, C_BtoV_);
+  s.q_ItoW = Quat(C).normalized();
+  s.p_IinW = fix.p_OinW + C * C_BtoV_.transpose() * module_.p_inV;
+  s.v_IinW = fix.v_OinW;
+  InitialUncertainty init;
+  init.position = fix.position_std;
+  init.velocity = fix.velocity_std;
+  init.roll_pitch = fix.level_std;
+  init.heading = fix.heading_std;
+  ekf_.initialize(s, ekf_.errors(), module_.noise, init, mech_);
+}
+
 Eigen::RowVector3d BodyIns::heading_sensitivity() const {
   // The vehicle x-axis C_v^w e1 moves like any vector attached to the b-frame.
   return wheel_heading_sensitivity(C_VtoW());

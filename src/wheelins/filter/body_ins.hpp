@@ -23,6 +23,9 @@ class BodyIns final : public Subsystem {
   /// The Body-IMU b-frame is its sensor frame; C_b^v enters the models instead.
   ImuSample to_body(const ImuSample& sensor) const override { return sensor; }
   void start(const StaticAccumulator& stat, double vehicle_heading, double t0) override;
+  void restart(const Vec3& mean_f_inB, const VehicleFix& fix) override;
+  /// Forward speed of o from the filter's own velocity [m/s].
+  double ins_speed() const { return (C_VtoW().transpose() * reference_velocity_inW()).x(); }
 
   /// C_v^w = C_b^w C_v^b.
   Mat3 C_VtoW() const { return ekf_.state().C_ItoW() * C_BtoV_.transpose(); }

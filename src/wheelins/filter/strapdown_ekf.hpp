@@ -66,6 +66,8 @@ class StrapdownEkf {
 
   /// Applies an error estimate (position, velocity, attitude, sensor errors) to the state.
   void feedback(const Vec21& dx);
+  /// Replaces the sensor-error estimates (e.g. with earlier ones after a fault).
+  void set_errors(const ImuErrors& e) { errors_ = e; }
 
  private:
   NavState state_;

@@ -10,6 +10,40 @@
 
 namespace wheelins {
 
+/// The vehicle state a subsystem restarts from after an outage or an isolation
+/// (from the other subsystems, or its own extrapolation when it is alone).
+struct VehicleFix {
+  double t = 0.0;
+  Vec3 p_OinW = Vec3::Zero();  ///< reference point o [m]
+  Vec3 v_OinW = Vec3::Zero();  ///< velocity of o [m/s]
+  double heading = 0.0;        ///< vehicle heading [rad]
+  double position_std = 0.1;   ///< [m]
+  double velocity_std = 0.3;   ///< [m/s]; also covers the lever-arm velocities left out
+  double level_std = 3.0 * kDeg;  ///< roll/pitch from the averaged specific force in motion
+  double heading_std = 1.0 * kDeg;
+};
+
+/// Mean specific force over a stretch of motion, expressed in the b-frame at its end:
+/// each increment is rotated into the first sample's b-frame with the gyro, summed,
+/// and the sum rotated to the last one (rotation averages out the centripetal and
+/// vibration terms of a spinning wheel).
+class MotionAccumulator {
+ public:
+  void clear() { *this = MotionAccumulator(); }
+  void add(const ImuSample& b) {
+    C_BnowToB0_ = C_BnowToB0_ * dcm_from_rotvec(b.dtheta);
+    sum_dvel_inB0_ += C_BnowToB0_ * b.dvel;
+    duration_ += b.dt;
+  }
+  double duration() const { return duration_; }
+  Vec3 mean_f_now() const { return C_BnowToB0_.transpose() * sum_dvel_inB0_ / duration_; }
+
+ private:
+  Mat3 C_BnowToB0_ = Mat3::Identity();
+  Vec3 sum_dvel_inB0_ = Vec3::Zero();
+  double duration_ = 0.0;
+};
+
 class Subsystem {
  public:
   Subsystem(const ModuleSpec& module, const MechanizationOptions& mech)
@@ -28,6 +62,10 @@ class Subsystem {
   virtual ImuSample to_body(const ImuSample& sensor) const = 0;
   /// Aligns from the static mean and starts with o at the w-frame origin.
   virtual void start(const StaticAccumulator& stat, double vehicle_heading, double t0) = 0;
+  /// Starts again in motion: level from `mean_f_inB` (the specific force averaged over the
+  /// realignment, b-frame now), heading and o from `fix`; the sensor-error estimates are
+  /// kept, their uncertainty is reset to the datasheet's.
+  virtual void restart(const Vec3& mean_f_inB, const VehicleFix& fix) = 0;
   /// One IMU epoch of b-frame data.
   virtual void propagate(const ImuSample& body_sample) { ekf_.propagate(body_sample); }
   virtual double vehicle_heading() const = 0;

@@ -35,9 +35,40 @@ void WheelIns::start(const StaticAccumulator& stat, double vehicle_heading, doub
   s.p_IinW = C_VtoW0 * module_.p_inV - C * module_.lever_arm_inB;
   ImuErrors e;
   e.bg = stat.mean_omega() - C.transpose() * mech_.omega_ie_inW;
-  ekf_.initialize(s, e, module_.noise, opt_.init, mech_);
+  begin(s, e, opt_.init);
+}
+
+void WheelIns::begin(const NavState& s, const ImuErrors& e, const InitialUncertainty& init) {
+  ekf_.initialize(s, e, module_.noise, init, mech_);
   window_count_ = window_pos_ = 0;
   window_sum_ = 0.0;
+}
+
+void WheelIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
+  // As start(), in motion: the wheel angle and axle tilt from the averaged specific force,
+  // the axle direction from the vehicle heading, the IMU placed from o by eq. (8).
+  Vec3 rpy = level_from_specific_force(mean_f_inB);
+  rpy.z() = wrap_pi(fix.heading + axle_sign_ * 0.5 * kPi);
+  NavState s;
+  s.t = fix.t;
+  s.q_ItoW = Quat(dcm_from_euler(rpy)).normalized();
+  const Mat3 C = s.C_ItoW();
+  s.p_IinW = fix.p_OinW + rot_z(fix.heading) * module_.p_inV - C * module_.lever_arm_inB;
+  s.v_IinW = fix.v_OinW;
+  InitialUncertainty init;
+  init.position = fix.position_std;
+  init.velocity = fix.velocity_std;
+  init.roll_pitch = fix.level_std;
+  init.heading = fix.heading_std;
+  begin(s, ekf_.errors(), init);
+}
+
+double WheelIns::ins_speed() const {
+  const NavState& s = ekf_.state();
+  const Mat3 C = s.C_ItoW();
+  const Vec3 omega_nb = ekf_.omega_ib_b() - C.transpose() * mech_.omega_ie_inW;
+  const Vec3 v_wc = s.v_IinW + C * omega_nb.cross(module_.lever_arm_inB);
+  return (C_VtoW().transpose() * v_wc).x();
 }
 
 void WheelIns::propagate(const ImuSample& body_sample) {

@@ -31,6 +31,7 @@ class WheelIns final : public Subsystem {
   /// Aligns from the static mean (b-frame samples) and starts navigating at time t0 with
   /// the reference point o at the w-frame origin and the given vehicle heading.
   void start(const StaticAccumulator& stat, double vehicle_heading, double t0) override;
+  void restart(const Vec3& mean_f_inB, const VehicleFix& fix) override;
 
   /// One IMU epoch (b-frame sample, see to_body).
   void propagate(const ImuSample& body_sample) override;
@@ -43,6 +44,10 @@ class WheelIns final : public Subsystem {
     double dbgx = 0.0, dsgx = 0.0;
   };
   SpeedSensitivity speed_sensitivity() const;
+  /// The b-frame x rate this wheel turns at when rolling at `speed` [rad/s].
+  double omega_x_at_speed(double speed) const { return -axle_sign_ * speed / module_.wheel_radius; }
+  /// Forward speed of the wheel centre from the filter's own velocity [m/s].
+  double ins_speed() const;
   /// Its velocity measurement noise covariance (Table 9).
   Mat3 velocity_noise() const { return opt_.velocity_std.cwiseAbs2().asDiagonal(); }
   double velocity_gate() const { return opt_.gate; }
@@ -69,6 +74,7 @@ class WheelIns final : public Subsystem {
   Vec3 reference_velocity_inW() const override;
 
  private:
+  void begin(const NavState& s, const ImuErrors& e, const InitialUncertainty& init);
   WheelInsOptions opt_;
   Mat3 C_StoB_;
   int axle_sign_;

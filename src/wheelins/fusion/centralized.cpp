@@ -21,6 +21,11 @@ class FixedJointCovariance final : public JointCovariance {
   void set_block(int i, const Mat21& P) override {
     P_.template block<kStateDim, kStateDim>(kStateDim * i, kStateDim * i) = P;
   }
+  void reset(int i, const Mat21& P) override {
+    P_.template middleRows<kStateDim>(kStateDim * i).setZero();
+    P_.template middleCols<kStateDim>(kStateDim * i).setZero();
+    set_block(i, P);
+  }
   Mat21 block(int i) const override {
     return P_.template block<kStateDim, kStateDim>(kStateDim * i, kStateDim * i);
   }

@@ -23,6 +23,8 @@ class JointCovariance {
   /// Block-diagonal start from the subsystems' own initial covariances.
   virtual void set_block(int i, const Mat21& P) = 0;
   virtual Mat21 block(int i) const = 0;
+  /// Subsystem i restarted with covariance P: its cross-covariances with the others are 0.
+  virtual void reset(int i, const Mat21& P) = 0;
   /// Subsystem i advanced by one epoch (F_i over dt); the others did not move.
   virtual void propagate(int i, const ErrorDynamics& d, const ProcessNoise& q, double dt) = 0;
   /// Fuses dz = sum_j H_j dx_j + e (H[j] == nullptr: no dependence on subsystem j),

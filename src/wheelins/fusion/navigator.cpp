@@ -1,6 +1,8 @@
 #include "wheelins/fusion/navigator.hpp"
 
 #include <chrono>
+#include <cstdio>
+#include <limits>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -31,6 +33,7 @@ std::string NavigatorOptions::describe() const {
                                                                        : "classic two-sample")
     << "\n"
     << "earth rotation:             " << (earth_rotation ? "compensated" : "ignored") << "\n"
+    << faults.describe()
     << "output interval:            "
     << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
     << "\n";
@@ -80,22 +83,36 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
     if (!(w >= 0.0) || !(wsum > 0.0))
       throw InputError("fusion weights must be >= 0 with a positive sum");
   for (double& w : weights_) w /= wsum;
+  if (subs_.size() > static_cast<std::size_t>(kMaxModules))
+    throw InputError(std::to_string(subs_.size()) + " modules selected; at most " +
+                     std::to_string(kMaxModules) + " can be fused");
   static_.resize(subs_.size());
   rp_models_.resize(subs_.size());
+  std::vector<std::string> names;
+  for (const auto& sub : subs_) names.push_back(sub->module().name);
+  faults_ = FaultMonitor(std::move(names), opt_.faults);
+  rt_.resize(subs_.size());
 }
 
 Navigator::~Navigator() = default;
 
 double Navigator::min_time() const {
-  double t = subs_[0]->time();
-  for (const auto& s : subs_) t = std::min(t, s->time());
+  double t = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < subsystem_count(); ++i)
+    if (in_use(i)) t = std::min(t, subs_[i]->time());
   return t;
+}
+
+int Navigator::output_driver() const {
+  for (int i = 0; i < subsystem_count(); ++i)
+    if (in_use(i)) return i;
+  return -1;
 }
 
 void Navigator::process(int index, const ImuSample& raw) {
   ++stats_.samples;
   Subsystem& s = *subs_[index];
-  const ImuSample b = s.to_body(raw);
+  ImuSample b = s.to_body(raw);
   if (!navigating_) {
     if (raw.t <= manifest_.static_start) return;
     if (raw.t <= manifest_.static_end + 1e-9) {
@@ -104,15 +121,38 @@ void Navigator::process(int index, const ImuSample& raw) {
     }
     start_navigation(manifest_.static_end);
   }
+  if (opt_.faults.enabled) {
+    Runtime& rt = rt_[index];
+    watch_outages(index, raw.t);
+    if (faults_.health(index) == Health::kOut || raw.dt > opt_.faults.max_gap) {
+      // The data come back (or jump): this sample's interval is unknown motion. Re-level
+      // on the next samples, then restart from the others.
+      char what[160];
+      std::snprintf(what, sizeof what, "data again after a gap of %.3f s", raw.t - rt.last_t);
+      ++faults_.stats(index).gaps;
+      rt.last_t = raw.t;
+      begin_realign(index, raw.t, what,
+                    "re-levelling on its next samples, then restarting from the others");
+      return;
+    }
+    rt.last_t = raw.t;
+    if (faults_.health(index) == Health::kRealign) {
+      rt.realign.add(b);
+      if (rt.realign.duration() + 1e-9 >= opt_.faults.realign_time) restart(index, raw.t);
+      return;
+    }
+    if (s.is_wheel() && s.module().gyro_range > 0.0) handle_saturation(index, raw, b);
+  }
   s.propagate(b);
   if (joint_) joint_->propagate(index, s.ekf().last_dynamics(), s.ekf().noise(), b.dt);
 
-  // Updates when every subsystem has reached the scheduled time.
+  // Updates when every subsystem in use has reached the scheduled time.
   const double t_all = min_time();
   using Clock = std::chrono::steady_clock;
   if (t_all + 1e-9 >= next_velocity_t_) {
     const auto t0 = Clock::now();
     velocity_updates();
+    check_covariances();
     stats_.velocity_step_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
     ++stats_.velocity_steps;
     while (next_velocity_t_ <= t_all + 1e-9) next_velocity_t_ += opt_.wheel.velocity_update_interval;
@@ -126,13 +166,20 @@ void Navigator::process(int index, const ImuSample& raw) {
       next_position_t_ += opt_.fusion.position_update_interval;
   }
 
-  if (index != 0) return;
+  if (index != output_driver()) return;
   ++stats_.epochs;
   stats_.t_end = raw.t;
   if (raw.t + 1e-9 >= next_output_t_) {
-    sink_(0, vehicle_record());
+    TrajectoryRecord v = vehicle_record();
+    v.t = raw.t;  // the epoch of the module driving the output
+    sink_(0, v);
     if (subs_.size() > 1)
-      for (int i = 0; i < subsystem_count(); ++i) sink_(i + 1, subsystem_record(i));
+      for (int i = 0; i < subsystem_count(); ++i)
+        // A module whose data have stopped (not yet declared out) has nothing new.
+        if (in_use(i) && subs_[i]->time() > rt_[i].last_record_t) {
+          rt_[i].last_record_t = subs_[i]->time();
+          sink_(i + 1, subsystem_record(i));
+        }
     ++stats_.records;
     if (opt_.output_interval > 0)
       while (next_output_t_ <= raw.t + 1e-9) next_output_t_ += opt_.output_interval;
@@ -141,13 +188,18 @@ void Navigator::process(int index, const ImuSample& raw) {
 
 void Navigator::start_navigation(double t0) {
   for (std::size_t i = 0; i < subs_.size(); ++i) {
-    if (static_[i].count() < 10)
-      throw InputError("module '" + subs_[i]->module().name + "': only " +
-                       std::to_string(static_[i].count()) + " samples in the static period [" +
-                       std::to_string(manifest_.static_start) + ", " +
-                       std::to_string(manifest_.static_end) +
-                       "] s: the alignment needs a static period covered by the data");
+    if (static_[i].count() < 10) {
+      char period[96];
+      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", manifest_.static_start,
+                    manifest_.static_end);
+      throw InputError("'" + manifest_.resolve(subs_[i]->module().file).string() + "' (module '" +
+                       subs_[i]->module().name + "'): only " +
+                       std::to_string(static_[i].count()) + " samples in the static period " +
+                       period + " of '" + manifest_.path.string() +
+                       "': the alignment needs the static period covered by every module's data");
+    }
     subs_[i]->start(static_[i], manifest_.initial_heading, t0);
+    rt_[i].last_t = t0;
   }
   if (opt_.fusion.centralized && subs_.size() > 1) {
     joint_ = make_joint_covariance(subsystem_count());
@@ -163,51 +215,76 @@ void Navigator::start_navigation(double t0) {
   next_position_t_ = t0 + opt_.fusion.position_update_interval;
 }
 
+bool Navigator::level_shared() const {
+  // The Body-INS level is shared only while the Body-INS counts (a module on probation or
+  // out does not pass its attitude on; the wheels keep the last level they were given).
+  return body_ && opt_.fusion.share_level && counted(body_index_);
+}
+
 void Navigator::share_level() {
-  if (body_ && opt_.fusion.share_level) {
-    const Vec3 rpy = body_->vehicle_rpy();
-    for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
-  }
+  if (!level_shared()) return;
+  const Vec3 rpy = body_->vehicle_rpy();
+  for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
 }
 
 void Navigator::add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
                                 std::array<H3, kMaxCentralized>& h) const {
-  if (!body_ || !opt_.fusion.share_level || c == 0.0) return;
+  if (!level_shared() || c == 0.0) return;
   h[body_index_].block<3, 3>(0, PHI) +=
       c * H_level * vehicle_level_sensitivity(body_->C_VtoW());
 }
 
 void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
   // The same measurements as the distributed filter (eq. 5 for a Wheel-INS, eq. 6 for the
-  // Body-INS), but one EKF over all error states (Section VI-B-2), so every dependence on
-  // another IMU's state is in H instead of being ignored:
-  //  - the mean wheel speed (1/n) sum_j (-a_j r_j omega_x,j) carries each Wheel-IMU's
-  //    r delta omega_x of eq. (3): -(1/n) dspeed_j/d(b_g,x, s_g,x) in block j (dz = z_hat -
-  //    z_meas); the Body-INS always uses the mean;
+  // Body-INS, with the fault handling's choice of speeds), but one EKF over all error states
+  // (Section VI-B-2), so every dependence on another IMU's state is in H instead of being
+  // ignored:
+  //  - the mean wheel speed (1/n) sum_j (-a_j r_j omega_x,j) over the wheels in the mean
+  //    (counted, speed usable: speeds_.in_mean, n = speeds_.n_mean) carries each of those
+  //    Wheel-IMUs' r delta omega_x of eq. (3): -(1/n) dspeed_j/d(b_g,x, s_g,x) in block j
+  //    (dz = z_hat - z_meas), also when it replaces a wheel's own unusable speed;
   //  - a Wheel-INS model uses the Body-INS roll/pitch (eq. 5, theta_3 and phi_3): its
   //    H_level times d(roll, pitch)/d(phi_3) in the Body-INS block.
   // Everything is evaluated at the current state: the speeds from the current gyro-x
-  // estimates, the level from the current Body-INS attitude.
+  // estimates, the level from the current Body-INS attitude. Which speeds are usable is
+  // decided once per update epoch (velocity_updates()).
   const int N = subsystem_count();
-  const double n = static_cast<double>(wheels_.size());
+  const SpeedSelection& sel = speeds_;
+  const int n_mean = sel.n_mean;
   double mean_speed = 0.0;
   Vec3 mean_point = Vec3::Zero();
-  for (const WheelIns* w : wheels_) {
-    mean_speed += w->wheel_speed() / n;
-    mean_point += w->module().p_inV / n;
+  for (int j = 0; j < N; ++j)
+    if (sel.in_mean[j]) {
+      const auto& w = static_cast<const WheelIns&>(*subs_[j]);
+      mean_speed += w.wheel_speed();
+      mean_point += w.module().p_inV;
+    }
+  if (n_mean) {
+    mean_speed /= n_mean;
+    mean_point /= n_mean;
   }
   for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
-  const bool wheel = subs_[i]->is_wheel();
-  const bool mean = !wheel || (opt_.fusion.speed == SpeedSharing::kMean && n > 1);
-  if (wheel) {
+  bool mean = false;  // the measured speed is the mean: its sensitivities are added below
+  if (subs_[i]->is_wheel()) {
     const auto& w = static_cast<const WheelIns&>(*subs_[i]);
     WheelVelocityInput in = w.own_velocity_input();
-    if (body_ && opt_.fusion.share_level) {
+    if (level_shared()) {
       const Vec3 rpy = body_->vehicle_rpy();
       in.vehicle_roll = rpy.x();
       in.vehicle_pitch = rpy.y();
     }
-    if (mean) {  // the speed's sensitivities are added below, for every wheel
+    jm.R = w.velocity_noise();
+    if (sel.speed_ok[i]) {
+      // Its own speed (in.dspeed_* stay this IMU's), or the mean it is part of.
+      mean = opt_.fusion.speed == SpeedSharing::kMean && n_mean > 1 && sel.in_mean[i];
+    } else if (n_mean > 0) {
+      mean = true;  // its own speed is unusable: the mean of the others'
+    } else {
+      // No speed at all: the NHC rows only.
+      in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+      jm.R(0, 0) = kNoSpeedVar;
+    }
+    if (mean) {
       in.measured_speed = mean_speed;
       in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
     }
@@ -215,7 +292,6 @@ void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
     jm.H[i] = m.H;
     add_level_block(m.H_level, 1.0, jm.H);
     jm.dz = m.innovation();
-    jm.R = w.velocity_noise();
     if (mean) {
       // The mean of the wheel speeds is the speed of the mean of the wheel centres (o for a
       // left/right pair), not of this wheel's centre, which eq. (5) predicts: in a turn it is
@@ -233,43 +309,82 @@ void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
     }
     jm.gate = w.velocity_gate();
   } else {
-    const BodyVelocityModel m = body_->velocity_model(mean_speed, mean_point);
+    // The mean speed of the wheels is the speed of the mean of their centres (o for a
+    // symmetric pair; the wheel centre itself for one wheel).
+    jm.R = body_->velocity_noise();
+    double speed = mean_speed;
+    mean = n_mean > 0;
+    if (!mean) {
+      speed = body_->ins_speed();
+      jm.R(0, 0) = kNoSpeedVar;
+      mean_point.setZero();
+    }
+    const BodyVelocityModel m = body_->velocity_model(speed, mean_point);
     jm.H[i] = m.H;
     jm.dz = m.innovation();
-    jm.R = body_->velocity_noise();
     jm.gate = body_->velocity_gate();
   }
   if (mean)
     for (int j = 0; j < N; ++j) {
-      if (!subs_[j]->is_wheel()) continue;
+      if (!sel.in_mean[j]) continue;
       const WheelIns::SpeedSensitivity ds =
           static_cast<const WheelIns&>(*subs_[j]).speed_sensitivity();
-      jm.H[j](0, BG) -= ds.dbgx / n;
-      jm.H[j](0, SG) -= ds.dsgx / n;
+      jm.H[j](0, BG) -= ds.dbgx / n_mean;
+      jm.H[j](0, SG) -= ds.dsgx / n_mean;
     }
 }
 
+bool Navigator::reference_weights(std::array<double, kMaxModules>& k, int& n_ref,
+                                  int& n_tied) const {
+  // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 9) is the
+  // reference, the weights renormalised over them (0 for the others).
+  const int n = subsystem_count();
+  k.fill(0.0);
+  double ksum = 0.0;
+  n_ref = n_tied = 0;
+  for (int i = 0; i < n; ++i) {
+    if (counted(i)) {
+      k[i] = weights_[i];
+      ksum += k[i];
+      ++n_ref;
+    }
+    n_tied += !opt_.faults.enabled || faults_.tied(i);
+  }
+  if (n_ref == 0 || !(ksum > 0.0)) return false;
+  for (int i = 0; i < n; ++i) k[i] /= ksum;
+  return true;
+}
+
 void Navigator::position_measurement(int i, JointMeasurement& jm) const {
-  // dz_i = r_o^i - sum_j k_j r_o^j (eq. 9, 12) depends on every subsystem's state:
+  std::array<double, kMaxModules> k{};
+  int n_ref = 0, n_tied = 0;
+  reference_weights(k, n_ref, n_tied);
+  position_measurement(i, k, jm);
+}
+
+void Navigator::position_measurement(int i, const std::array<double, kMaxModules>& k,
+                                     JointMeasurement& jm) const {
+  // dz_i = r_o^i - sum_j k_j r_o^j (eq. 9, 12) depends on every counted subsystem's state:
   // (1 - k_i) H_i in block i and -k_j H_j in the others, and, through the level a Wheel-INS
   // uses in C_v^w (eq. 8), on the Body-INS attitude.
   const int N = subsystem_count();
   Vec3 level = Vec3::Zero();
-  const bool shared = body_ && opt_.fusion.share_level;
+  const bool shared = level_shared();
   if (shared) level = body_->vehicle_rpy();
   Vec3 fused = Vec3::Zero(), own = Vec3::Zero();
   for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
   for (int j = 0; j < N; ++j) {
+    const double c = (j == i ? 1.0 : 0.0) - k[j];
+    if (c == 0.0 && k[j] == 0.0) continue;  // neither this module nor in the reference
     ReferencePointInput in = subs_[j]->reference_point_input();
     if (shared && in.wheel) {
       in.vehicle_roll = level.x();
       in.vehicle_pitch = level.y();
     }
     const ReferencePointModel m = reference_point_model(in);
-    const double c = (j == i ? 1.0 : 0.0) - weights_[j];
     jm.H[j] += c * m.H;
     if (in.wheel) add_level_block(m.H_level, c, jm.H);
-    fused += weights_[j] * m.r_o;
+    fused += k[j] * m.r_o;
     if (j == i) own = m.r_o;
   }
   jm.dz = own - fused;
@@ -288,56 +403,145 @@ UpdateReport Navigator::fuse_joint(const JointMeasurement& m) {
   return rep;
 }
 
-void Navigator::velocity_updates_centralized() {
-  // Sequential updates, each evaluated at the state the previous one left (the joint
-  // correction moves every IMU's errors).
-  JointMeasurement& m = joint_scratch_;
-  for (int i = 0; i < subsystem_count(); ++i) {
-    share_level();
-    velocity_measurement(i, m);
-    const UpdateReport rep = fuse_joint(m);
-    ++stats_.velocity_updates;
-    if (!rep.accepted) ++stats_.velocity_rejected;
-    stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
+void Navigator::count_velocity_update(int i, const UpdateReport& rep, double t_now) {
+  ++stats_.velocity_updates;
+  if (!rep.accepted) {
+    ++stats_.velocity_rejected;
+    ++faults_.stats(i).velocity_rejected;
+  }
+  stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
+  if (!opt_.faults.enabled || !faults_.velocity_test(i, rep.test_ratio)) return;
+  // The detector fired: isolate the module if the others can go on without it.
+  char what[200];
+  std::snprintf(what, sizeof what,
+                "velocity innovations inconsistent: %d of the last %d test ratios over %.1f",
+                opt_.faults.max_failed, opt_.faults.window, opt_.faults.test_ratio);
+  const int others_ok = faults_.count_ok() - (faults_.counts(i) ? 1 : 0);
+  if (subsystem_count() > 1 && others_ok >= 1 && faults_.tied(i)) {
+    isolate(i, t_now, what);
+  } else if (!rt_[i].detector_fired) {
+    rt_[i].detector_fired = true;
+    faults_.note(i, t_now, what, "no other module to take over: kept (reported once)");
   }
 }
 
 void Navigator::velocity_updates() {
-  if (joint_) {
-    velocity_updates_centralized();
-    return;
-  }
+  const bool handle = opt_.faults.enabled;
+  const double t_now = min_time();
+  if (handle) fault_housekeeping(t_now);
   // Shared information (Section III): vehicle level from the Body-INS, wheel speed.
   share_level();
-  const double n = static_cast<double>(wheels_.size());
+  // Which wheel speeds can be used: not saturated, and (fault handling on) agreeing with
+  // the wheel's own INS to within speed_gate sigma of the predicted forward velocity.
+  const int n_sub = subsystem_count();
+  SpeedSelection& sel = speeds_;
+  sel = SpeedSelection();
+  std::array<bool, kMaxModules> saturated{};
+  std::array<WheelVelocityInput, kMaxModules> own;
+  int& n_mean = sel.n_mean;
   double mean_speed = 0.0;
   Vec3 mean_point = Vec3::Zero();
-  for (WheelIns* w : wheels_) {
-    mean_speed += w->wheel_speed() / n;
-    mean_point += w->module().p_inV / n;
+  for (int i = 0; i < n_sub; ++i) {
+    if (!subs_[i]->is_wheel() || !in_use(i)) continue;
+    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
+    own[i] = w.own_velocity_input();
+    bool ok = true;
+    if (handle) {
+      Runtime& rt = rt_[i];
+      if (t_now < rt.saturated_until) {
+        ok = false;
+        saturated[i] = true;
+      } else {
+        const WheelVelocityModel m = wheel_velocity_model(own[i]);
+        const Mat21 P = covariance(i);
+        const double s_xx = m.H.row(0) * P * m.H.row(0).transpose() + w.velocity_noise()(0, 0);
+        const double e = m.innovation().x();
+        if (std::abs(e) > opt_.faults.speed_gate * std::sqrt(s_xx)) {
+          ok = false;
+          ++faults_.stats(i).speed_rejected;
+          if (!rt.speed_rejected) {
+            char what[160];
+            std::snprintf(what, sizeof what,
+                          "wheel speed %.3f m/s disagrees with its INS (%.3f m/s, %.1f sigma): "
+                          "slip or a lifted wheel",
+                          own[i].measured_speed, m.z_hat.x(), std::abs(e) / std::sqrt(s_xx));
+            faults_.note(i, t_now, what, "speed not used until it agrees again");
+          }
+        } else if (rt.speed_rejected) {
+          faults_.note(i, t_now, "wheel speed agrees again", "speed used again");
+        }
+        rt.speed_rejected = !ok;
+      }
+    }
+    sel.speed_ok[i] = ok;
+    if (ok && counted(i)) {
+      sel.in_mean[i] = true;
+      ++n_mean;
+      mean_speed += own[i].measured_speed;
+      mean_point += w.module().p_inV;
+    }
   }
-  auto count = [&](const UpdateReport& rep) {
-    ++stats_.velocity_updates;
-    if (!rep.accepted) ++stats_.velocity_rejected;
-    stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
-  };
-  for (int i = 0; i < subsystem_count(); ++i) {
+  if (n_mean == 0)
+    // Every wheel saturated: their clipped speeds (lower bounds) are better than none.
+    for (int i = 0; i < n_sub; ++i)
+      if (saturated[i] && counted(i)) {
+        sel.speed_ok[i] = sel.in_mean[i] = true;
+        ++n_mean;
+        mean_speed += own[i].measured_speed;
+        mean_point += subs_[i]->module().p_inV;
+      }
+  if (joint_) {
+    // Sequential updates, each evaluated at the state the previous one left (the joint
+    // correction moves every IMU's errors); the speed selection stays the epoch's.
+    JointMeasurement& m = joint_scratch_;
+    for (int i = 0; i < n_sub; ++i) {
+      if (!in_use(i)) continue;
+      share_level();
+      velocity_measurement(i, m);
+      count_velocity_update(i, fuse_joint(m), t_now);
+    }
+    return;
+  }
+  if (n_mean) {
+    mean_speed /= n_mean;
+    mean_point /= n_mean;
+  }
+  for (int i = 0; i < n_sub; ++i) {
+    if (!in_use(i)) continue;
     if (subs_[i]->is_wheel()) {
       const auto& w = static_cast<const WheelIns&>(*subs_[i]);
-      WheelVelocityInput in = w.own_velocity_input();
-      if (opt_.fusion.speed == SpeedSharing::kMean && wheels_.size() > 1) {
-        // Its own speed enters the mean with weight 1/n.
+      WheelVelocityInput in = own[i];
+      Mat3 R = w.velocity_noise();
+      if (sel.speed_ok[i]) {
+        if (opt_.fusion.speed == SpeedSharing::kMean && n_mean > 1 && counted(i)) {
+          // Its own speed enters the mean with weight 1/n.
+          in.measured_speed = mean_speed;
+          in.dspeed_dbgx /= n_mean;
+          in.dspeed_dsgx /= n_mean;
+        }
+      } else if (n_mean > 0) {
+        // Its own speed is unusable: the others' (independent of its states).
         in.measured_speed = mean_speed;
-        in.dspeed_dbgx /= n;
-        in.dspeed_dsgx /= n;
+        in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+      } else {
+        // No speed at all: the NHC rows only.
+        in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+        R(0, 0) = kNoSpeedVar;
       }
       const WheelVelocityModel m = wheel_velocity_model(in);
-      count(fuse(i, m.H, m.innovation(), w.velocity_noise(), w.velocity_gate()));
+      count_velocity_update(i, fuse(i, m.H, m.innovation(), R, w.velocity_gate()), t_now);
     } else {
       // The mean speed of the wheels is the speed of the mean of their centres (o for a
       // symmetric pair; the wheel centre itself for one wheel).
-      const BodyVelocityModel m = body_->velocity_model(mean_speed, mean_point);
-      count(fuse(i, m.H, m.innovation(), body_->velocity_noise(), body_->velocity_gate()));
+      Mat3 R = body_->velocity_noise();
+      double speed = mean_speed;
+      if (n_mean == 0) {
+        speed = body_->ins_speed();
+        R(0, 0) = kNoSpeedVar;
+        mean_point.setZero();
+      }
+      const BodyVelocityModel m = body_->velocity_model(speed, mean_point);
+      count_velocity_update(i, fuse(i, m.H, m.innovation(), R, body_->velocity_gate()), t_now);
     }
   }
 }
@@ -358,35 +562,46 @@ Mat21 Navigator::covariance(int i) const {
 }
 
 void Navigator::position_update() {
-  if (joint_) {
-    // Sequentially, each re-evaluated at the state the previous one left.
-    JointMeasurement& m = joint_scratch_;
-    for (int i = 0; i < subsystem_count(); ++i) {
-      share_level();
-      position_measurement(i, m);
-      const UpdateReport rep = fuse_joint(m);
-      ++stats_.position_updates;
-      if (!rep.accepted) ++stats_.position_rejected;
-      stats_.max_position_test_ratio = std::max(stats_.max_position_test_ratio, rep.test_ratio);
-    }
-    return;
-  }
-  // Algorithm 1: o in every subsystem's frame, their weighted mean as the measurement.
-  std::vector<ReferencePointModel>& models = rp_models_;
-  Vec3 fused = Vec3::Zero();
-  for (std::size_t i = 0; i < subs_.size(); ++i) {
-    models[i] = reference_point_model(subs_[i]->reference_point_input());
-    fused += weights_[i] * models[i].r_o;
-  }
-  const double sd = opt_.fusion.position_std;
-  const Mat3 R = Mat3::Identity() * sd * sd;
-  for (std::size_t i = 0; i < subs_.size(); ++i) {
-    const Vec3 dz = models[i].r_o - fused;
-    const UpdateReport rep =
-        subs_[i]->ekf().update<3>(models[i].H, dz, R, opt_.fusion.position_gate);
+  // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 9) is the
+  // reference; modules on probation are tied to it without moving it.
+  const int n = subsystem_count();
+  std::array<double, kMaxModules> k{};
+  int n_ref = 0, n_tied = 0;
+  const bool have_ref = reference_weights(k, n_ref, n_tied);
+  if (opt_.faults.enabled) check_headings(min_time());
+  if (!have_ref || n_tied < 2) return;
+  auto record = [&](const UpdateReport& rep) {
     ++stats_.position_updates;
     if (!rep.accepted) ++stats_.position_rejected;
     stats_.max_position_test_ratio = std::max(stats_.max_position_test_ratio, rep.test_ratio);
+  };
+  auto receives = [&](int i) {
+    // A lone reference module is not constrained by itself.
+    return (!opt_.faults.enabled || faults_.tied(i)) && !(n_ref == 1 && k[i] > 0.0);
+  };
+  if (joint_) {
+    // Sequentially, each re-evaluated at the state the previous one left.
+    JointMeasurement& m = joint_scratch_;
+    for (int i = 0; i < n; ++i) {
+      if (!receives(i)) continue;
+      share_level();
+      position_measurement(i, k, m);
+      record(fuse_joint(m));
+    }
+    return;
+  }
+  std::vector<ReferencePointModel>& models = rp_models_;
+  Vec3 fused = Vec3::Zero();
+  for (int i = 0; i < n; ++i) {
+    models[i] = reference_point_model(subs_[i]->reference_point_input());
+    fused += k[i] * models[i].r_o;
+  }
+  const double sd = opt_.fusion.position_std;
+  const Mat3 R = Mat3::Identity() * sd * sd;
+  for (int i = 0; i < n; ++i) {
+    if (!receives(i)) continue;
+    const Vec3 dz = models[i].r_o - fused;
+    record(subs_[i]->ekf().update<3>(models[i].H, dz, R, opt_.fusion.position_gate));
   }
 }
 
@@ -425,16 +640,37 @@ TrajectoryRecord Navigator::subsystem_record(int i) const {
 }
 
 TrajectoryRecord Navigator::vehicle_record() const {
-  TrajectoryRecord r = subsystem_record(0);
-  if (subs_.size() == 1) return r;
+  std::array<bool, kMaxModules> use{};
+  bool any = false;
+  for (int i = 0; i < subsystem_count(); ++i) any |= use[i] = counted(i);
+  if (!any)
+    for (int i = 0; i < subsystem_count(); ++i) use[i] = in_use(i);
+  return fused_record(use);
+}
+
+TrajectoryRecord Navigator::fused_record(const std::array<bool, kMaxModules>& use) const {
+  int first = -1, n_use = 0;
+  double ksum = 0.0;
+  for (int i = 0; i < subsystem_count(); ++i)
+    if (use[i]) {
+      if (first < 0) first = i;
+      ++n_use;
+      ksum += weights_[i];
+    }
+  if (first < 0) first = 0;
+  TrajectoryRecord r = subsystem_record(first);
+  if (subs_.size() == 1 || n_use <= 1) return r;
   // Output as in the paper: the fused reference point and the mean heading. The 1-sigma
   // of a weighted mean is bounded by the weighted mean of the sigmas whatever the
   // correlation between subsystems (Minkowski), which is what is reported.
   Vec3 p = Vec3::Zero(), v = Vec3::Zero(), p_std = Vec3::Zero(), v_std = Vec3::Zero();
   double s = 0.0, c = 0.0, psi_std = 0.0;
+  int body_index = -1;
   for (int i = 0; i < subsystem_count(); ++i) {
+    if (!use[i]) continue;
+    if (subs_[i].get() == body_) body_index = i;
     const TrajectoryRecord ri = subsystem_record(i);
-    const double k = weights_[i];
+    const double k = weights_[i] / ksum;
     p += k * ri.p_inN;
     v += k * ri.v_inN;
     p_std += k * ri.p_std;
@@ -450,11 +686,210 @@ TrajectoryRecord Navigator::vehicle_record() const {
   r.v_std = v_std;
   r.rpy.z() = std::atan2(s, c);
   r.rpy_std.z() = psi_std;
-  if (body_) {
+  if (body_index >= 0) {
     const Vec3 rpy = body_->vehicle_rpy();
     r.rpy.head<2>() = rpy.head<2>();
   }
   return r;
 }
+
+// ------------------------------------------------------------------ fault handling
+
+void Navigator::watch_outages(int index, double t) {
+  for (int j = 0; j < subsystem_count(); ++j) {
+    if (j == index) continue;
+    const Health h = faults_.health(j);
+    if (h == Health::kOut) continue;
+    if (t - rt_[j].last_t > opt_.faults.stale_after) {
+      char what[96];
+      std::snprintf(what, sizeof what, "no data after t=%.3f", rt_[j].last_t);
+      faults_.transition(j, Health::kOut, rt_[j].last_t, what,
+                         "left out of the fusion until its data return");
+    }
+  }
+}
+
+bool Navigator::substitute_speed(int wheel_index, double* speed) const {
+  // Only another wheel's gyro measures the speed independently; with every wheel
+  // saturated the clipped readings (a lower bound) are all there is.
+  const double t = subs_[wheel_index]->time();
+  double sum = 0.0;
+  int n = 0;
+  for (int j = 0; j < subsystem_count(); ++j)
+    if (j != wheel_index && subs_[j]->is_wheel() && counted(j) && !(t < rt_[j].saturated_until)) {
+      sum += static_cast<const WheelIns&>(*subs_[j]).wheel_speed();
+      ++n;
+    }
+  if (n) *speed = sum / n;
+  return n > 0;
+}
+
+void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b) {
+  const double full = opt_.faults.saturation_margin * subs_[index]->module().gyro_range * raw.dt;
+  if (!(raw.dtheta.cwiseAbs().maxCoeff() >= full)) return;
+  Runtime& rt = rt_[index];
+  ++faults_.stats(index).saturated_samples;
+  double v = 0.0;
+  const bool substituted = substitute_speed(index, &v);
+  if (!rt.saturation_reported) {
+    rt.saturation_reported = true;
+    char what[128];
+    std::snprintf(what, sizeof what, "gyro at full scale (%.0f deg/s)",
+                  subs_[index]->module().gyro_range / kDeg);
+    faults_.note(index, raw.t, what,
+                 substituted ? "axle rate from the other wheels' speed; own speed not used"
+                             : "no unsaturated wheel: clipped reading kept (speed is a lower "
+                               "bound)");
+  }
+  rt.saturated_until = raw.t + opt_.faults.saturation_hold;
+  if (!substituted) return;
+  // The axle rate the wheel must have at that speed replaces the clipped reading (the
+  // estimated bias is added back, as the filter removes it). The edited sample is what
+  // propagate() gets, so the speed window (raw rates, compensated with the current
+  // estimates) holds the substituted rate too. (Putting the scale factor back as well,
+  // (1 + s_g,x), made the saturation test worse: 3.3 % drift instead of 1.2 %.)
+  // The reading says the wheel turns at least at full scale.
+  const auto& w = static_cast<const WheelIns&>(*subs_[index]);
+  const double floor = subs_[index]->module().gyro_range * subs_[index]->module().wheel_radius;
+  const double v_sub = std::abs(v) >= floor ? v : std::copysign(floor, v);
+  b.dtheta.x() = (w.omega_x_at_speed(v_sub) + w.ekf().errors().bg.x()) * b.dt;
+}
+
+void Navigator::fault_housekeeping(double t) {
+  for (int i = 0; i < subsystem_count(); ++i) {
+    Runtime& rt = rt_[i];
+    if (faults_.counts(i) && t - rt.snapshot_t >= kSnapshotInterval) {
+      rt.errors_old = rt.have_snapshot ? rt.errors_new : subs_[i]->ekf().errors();
+      rt.errors_new = subs_[i]->ekf().errors();
+      rt.snapshot_t = t;
+      rt.have_snapshot = true;
+    }
+    if (rt.saturation_reported && !(t < rt.saturated_until)) {
+      rt.saturation_reported = false;
+      faults_.note(i, t, "gyro back in range", "own speed used again");
+    }
+    const Health h = faults_.health(i);
+    if (h == Health::kProbation && t - faults_.since(i) >= opt_.faults.probation)
+      faults_.transition(i, Health::kOk, t, "probation passed",
+                         "back in the fused solution");
+    else if (h == Health::kIsolated && t - faults_.since(i) >= opt_.faults.retry_after)
+      begin_realign(i, t, "retry after isolation", "re-levelling, then restarting from the others");
+  }
+}
+
+void Navigator::isolate(int i, double t, const std::string& what) {
+  faults_.transition(i, Health::kIsolated, t, what,
+                     "isolated: out of the fused solution, the mean speed and the constraint");
+  faults_.clear_tests(i);
+  rt_[i].revert_errors = true;
+  rt_[i].heading_fails = 0;
+}
+
+void Navigator::check_headings(double t) {
+  // Vehicle heading of every module in good health against the circular mean of the
+  // others (the attitude the subsystems share, Section III). With three or more, the
+  // one that disagrees most, beyond heading_gate for heading_epochs constraint epochs
+  // in a row, is isolated.
+  const int n = subsystem_count();
+  if (faults_.count_ok() < 3) return;
+  std::array<double, kMaxModules> d{};
+  int worst = -1;
+  for (int i = 0; i < n; ++i) {
+    if (!faults_.counts(i)) continue;
+    double s = 0.0, c = 0.0;
+    for (int j = 0; j < n; ++j)
+      if (j != i && faults_.counts(j)) {
+        s += weights_[j] * std::sin(subs_[j]->vehicle_heading());
+        c += weights_[j] * std::cos(subs_[j]->vehicle_heading());
+      }
+    d[i] = std::abs(wrap_pi(subs_[i]->vehicle_heading() - std::atan2(s, c)));
+    if (worst < 0 || d[i] > d[worst]) worst = i;
+  }
+  for (int i = 0; i < n; ++i) {
+    Runtime& rt = rt_[i];
+    if (i == worst && d[i] > opt_.faults.heading_gate) ++rt.heading_fails;
+    else rt.heading_fails = 0;
+    if (rt.heading_fails >= opt_.faults.heading_epochs) {
+      char what[160];
+      std::snprintf(what, sizeof what, "heading %.1f deg off the others' for %d epochs",
+                    d[i] / kDeg, rt.heading_fails);
+      isolate(i, t, what);
+    }
+  }
+}
+
+void Navigator::begin_realign(int i, double t, const std::string& what, const std::string& action) {
+  rt_[i].realign.clear();
+  faults_.transition(i, Health::kRealign, t, what, action);
+}
+
+VehicleFix Navigator::vehicle_fix(int i, double t) const {
+  std::array<bool, kMaxModules> use{};
+  bool any = false;
+  for (int j = 0; j < subsystem_count(); ++j) any |= use[j] = j != i && counted(j);
+  if (!any)
+    for (int j = 0; j < subsystem_count(); ++j) any |= use[j] = j != i && in_use(j);
+  VehicleFix fix;
+  fix.t = t;
+  if (any) {
+    const TrajectoryRecord r = fused_record(use);
+    fix.p_OinW = r.p_inN + r.v_inN * (t - r.t);
+    fix.v_OinW = r.v_inN;
+    fix.heading = r.rpy.z();
+    fix.position_std = r.p_std.norm() + 0.05;
+    fix.heading_std = r.rpy_std.z() + 0.5 * kDeg;
+    return fix;
+  }
+  // Alone: its own solution before the gap, extrapolated at constant velocity; the
+  // uncertainty grows with the distance driven blind.
+  const TrajectoryRecord r = subsystem_record(i);
+  const double blind = (t - r.t) * r.v_inN.norm();
+  fix.p_OinW = r.p_inN + r.v_inN * (t - r.t);
+  fix.v_OinW = r.v_inN;
+  fix.heading = r.rpy.z();
+  fix.position_std = r.p_std.norm() + 0.1 + 0.3 * blind;
+  fix.heading_std = r.rpy_std.z() + 2.0 * kDeg;
+  return fix;
+}
+
+void Navigator::restart(int i, double t) {
+  const VehicleFix fix = vehicle_fix(i, t);
+  if (rt_[i].revert_errors && rt_[i].have_snapshot) {
+    // The sensor-error estimates learnt while the fault went undetected are not trusted:
+    // back to those of 10-20 s before the detection.
+    subs_[i]->ekf().set_errors(rt_[i].errors_old);
+  }
+  rt_[i].revert_errors = false;
+  subs_[i]->restart(rt_[i].realign.mean_f_now(), fix);
+  if (joint_) joint_->reset(i, subs_[i]->ekf().covariance());
+  faults_.clear_tests(i);
+  ++faults_.stats(i).restarts;
+  rt_[i].detector_fired = false;
+  char what[160];
+  std::snprintf(what, sizeof what, "re-initialised (o within %.2f m, heading within %.2f deg)",
+                fix.position_std, fix.heading_std / kDeg);
+  if (subsystem_count() == 1)
+    faults_.transition(i, Health::kOk, t, what, "navigating again");
+  else
+    faults_.transition(i, Health::kProbation, t, what,
+                       "on probation: tied to the others by the constraint, out of the fused "
+                       "solution");
+}
+
+void Navigator::check_covariances() {
+  for (int i = 0; i < subsystem_count(); ++i) {
+    if (!in_use(i)) continue;
+    const Mat21 P = covariance(i);
+    ++stats_.covariance_checks;
+    const double scale = P.cwiseAbs().maxCoeff();
+    if (scale > 0.0)
+      stats_.max_covariance_asymmetry = std::max(
+          stats_.max_covariance_asymmetry, (P - P.transpose()).cwiseAbs().maxCoeff() / scale);
+    const Eigen::LLT<Mat21> llt(P);
+    if (llt.info() != Eigen::Success || !(scale > 0.0)) ++stats_.covariance_not_pd;
+  }
+}
+
+void Navigator::finish() { faults_.finish(stats_.t_end); }
 
 }  // namespace wheelins

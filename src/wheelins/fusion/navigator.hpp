@@ -20,6 +20,7 @@
 #include "wheelins/filter/body_ins.hpp"
 #include "wheelins/filter/wheel_ins.hpp"
 #include "wheelins/fusion/centralized.hpp"
+#include "wheelins/fusion/fault_monitor.hpp"
 #include "wheelins/io/trajectory.hpp"
 
 namespace wheelins {
@@ -49,6 +50,8 @@ struct NavigatorOptions {
   MechanizationOptions::Method mechanization = MechanizationOptions::Method::kRotationExact;
   /// Compensate the earth rotation (the manifest says whether the data contain it).
   bool earth_rotation = true;
+  /// Sensor-fault handling: outages, saturation, slip, isolation of faulty IMUs.
+  FaultOptions faults;
   /// Output interval [s]; 0 = every epoch of the first module.
   double output_interval = 0.0;
   /// The options in human units (OpenVINS style), one per line.
@@ -71,6 +74,11 @@ struct NavigatorStats {
   /// their number of occurrences, for the paper's Table 8 [s].
   double velocity_step_seconds = 0.0, position_step_seconds = 0.0;
   std::uint64_t velocity_steps = 0, position_steps = 0;
+  /// Covariance health, checked at every velocity-update step for every subsystem in use:
+  /// checks, failures of the Cholesky test (not positive definite), and the largest
+  /// asymmetry max|P - P^T| / max|P| seen.
+  std::uint64_t covariance_checks = 0, covariance_not_pd = 0;
+  double max_covariance_asymmetry = 0.0;
 };
 
 /// One measurement of the centralized filter: dz = sum_j H[j] dx_j + e, e ~ N(0, R).
@@ -83,6 +91,7 @@ struct JointMeasurement {
 
 class Navigator {
  public:
+  static constexpr int kMaxModules = 16;
   /// Receives records: stream 0 is the vehicle (the fused solution), streams 1..N the
   /// subsystems' own solutions (only when N > 1).
   using Sink = std::function<void(int stream, const TrajectoryRecord&)>;
@@ -105,18 +114,40 @@ class Navigator {
   /// The centralized filter's measurements of subsystem i at the current state (also
   /// usable without a joint covariance, for checking them): the velocity + NHC update
   /// (eq. 5/6) and the position constraint (eq. 12), H with a block for every IMU.
+  /// With fault handling, only the modules that count enter the mean wheel speed and the
+  /// reference (the velocity measurement uses the speed selection of the last update epoch).
   void velocity_measurement(int i, JointMeasurement& m) const;
   void position_measurement(int i, JointMeasurement& m) const;
   /// The fused vehicle solution now.
   TrajectoryRecord vehicle_record() const;
+  /// Health, counters and the report of detected faults.
+  const FaultMonitor& faults() const { return faults_; }
+  /// Closes the fault statistics at the end of the data.
+  void finish();
 
  private:
   void start_navigation(double t0);
+  /// Forward variance of a velocity row that carries no speed [m^2/s^2].
+  static constexpr double kNoSpeedVar = 1e4;
+  /// The wheel speeds an update epoch uses: speed_ok (in use, not saturated, agreeing with
+  /// its own INS) and in_mean (also counted: the wheels whose speeds make the mean).
+  struct SpeedSelection {
+    std::array<bool, kMaxModules> speed_ok{}, in_mean{};
+    int n_mean = 0;
+  };
+  /// Velocity updates of every module in use; in the centralized filter H also carries the
+  /// other IMUs' blocks (velocity_measurement()).
   void velocity_updates();
-  /// The centralized filter's velocity updates: H also carries the other IMUs' blocks.
-  void velocity_updates_centralized();
+  void count_velocity_update(int i, const UpdateReport& rep, double t_now);
+  /// The Body-INS level is shared: sharing on and the Body-INS counted.
+  bool level_shared() const;
   /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
   void share_level();
+  /// The reference weights k (eq. 9) renormalised over the counted modules (0 for the
+  /// others); false when no module counts.
+  bool reference_weights(std::array<double, kMaxModules>& k, int& n_ref, int& n_tied) const;
+  void position_measurement(int i, const std::array<double, kMaxModules>& k,
+                            JointMeasurement& m) const;
   /// Adds, to the Body-INS block of a joint H, the dependence of a Wheel-INS measurement on
   /// the shared level: H_level * d(roll, pitch)/d(phi_body), scaled by `c`.
   void add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
@@ -128,7 +159,39 @@ class Navigator {
   UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
   Mat21 covariance(int i) const;
   TrajectoryRecord subsystem_record(int i) const;
+  /// Weighted mean of the subsystems in `use` (the paper's output, eq. 9).
+  TrajectoryRecord fused_record(const std::array<bool, kMaxModules>& use) const;
   double min_time() const;
+
+  // Fault handling (fault_monitor.hpp).
+  struct Runtime {
+    double last_t = 0.0;             ///< newest sample seen
+    double last_record_t = -1e300;   ///< time of the last subsystem record written
+    MotionAccumulator realign;       ///< while kRealign
+    double saturated_until = -1e300; ///< the gyro was at full scale until this time + hold
+    bool saturation_reported = false;
+    bool speed_rejected = false;     ///< in a streak of rejected wheel speeds
+    bool detector_fired = false;     ///< reported once for a lone module
+    int heading_fails = 0;           ///< consecutive constraint epochs off the others' heading
+    ImuErrors errors_new, errors_old;  ///< sensor-error estimates 0-10 s and 10-20 s ago
+    double snapshot_t = -1e300;
+    bool have_snapshot = false;
+    bool revert_errors = false;      ///< restart from errors_old (after an isolation)
+  };
+  static constexpr double kSnapshotInterval = 10.0;  ///< [s]
+  void isolate(int i, double t, const std::string& what);
+  void check_headings(double t);
+  void check_covariances();
+  bool in_use(int i) const { return !opt_.faults.enabled || faults_.flowing(i); }
+  bool counted(int i) const { return !opt_.faults.enabled || faults_.counts(i); }
+  int output_driver() const;
+  void watch_outages(int index, double t);
+  void handle_saturation(int index, const ImuSample& raw, ImuSample& b);
+  bool substitute_speed(int wheel_index, double* speed) const;
+  void begin_realign(int i, double t, const std::string& what, const std::string& action);
+  void restart(int i, double t);
+  VehicleFix vehicle_fix(int i, double t) const;
+  void fault_housekeeping(double t);
 
   Manifest manifest_;
   NavigatorOptions opt_;
@@ -143,6 +206,9 @@ class Navigator {
   std::vector<ReferencePointModel> rp_models_;  ///< scratch of position_update(), sized once
   std::unique_ptr<JointCovariance> joint_;
   JointMeasurement joint_scratch_;  ///< of the centralized updates
+  SpeedSelection speeds_;           ///< the wheel speeds usable at the last update epoch
+  FaultMonitor faults_;
+  std::vector<Runtime> rt_;
   bool navigating_ = false;
   double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
   NavigatorStats stats_;

@@ -1,6 +1,7 @@
 #include "wheelins/fusion/run.hpp"
 
 #include <chrono>
+#include <cstdio>
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/imu_file.hpp"
@@ -26,6 +27,7 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
   for (TrajectoryFormat f : r.formats) files.push_back(r.output_dir / (std::string("trajectory") + extension(f)));
   if (multi(r))
     for (const auto& m : r.modules) files.push_back(r.output_dir / (m + ".csv"));
+  files.push_back(r.output_dir / "faults.csv");
   return files;
 }
 
@@ -97,14 +99,28 @@ RunResult run_navigation(const RunRequest& r) {
     progress.update(n);
   }
   progress.finish();
-  if (!nav.navigating())
-    throw InputError("the data end before the static period [" +
-                     std::to_string(r.manifest.static_start) + ", " +
-                     std::to_string(r.manifest.static_end) + "] s does: nothing to navigate");
+  if (!nav.navigating()) {
+    char period[96];
+    std::snprintf(period, sizeof period, "[%.3f, %.3f] s", r.manifest.static_start,
+                  r.manifest.static_end);
+    std::string files;
+    for (const auto& name : r.modules)
+      files += (files.empty() ? "'" : ", '") + r.manifest.resolve(r.manifest.find(name)->file).string() + "'";
+    throw InputError(files + ": the data end before the static period " + period + " of '" +
+                     r.manifest.path.string() + "' does: nothing to navigate");
+  }
 
+  nav.finish();
   RunResult result;
   for (auto& w : vehicle) w->commit();
   for (auto& w : subsystems) w->commit();
+  if (!r.output_dir.empty()) {
+    AtomicTextFile report(r.output_dir / "faults.csv", r.overwrite);
+    report.write(fault_report_csv(nav.faults()));
+    report.commit();
+  }
+  result.fault_report = fault_report_text(nav.faults());
+  result.fault_events = nav.faults().events();
   result.files = outputs;
   result.stats = nav.stats();
   result.filter_seconds = filter_seconds;

@@ -34,6 +34,8 @@ struct RunResult {
   double wall_seconds = 0.0;
   double filter_seconds = 0.0;  ///< time inside the navigator, output sink included (no input reading)
   std::vector<std::filesystem::path> files;  ///< what was written
+  std::string fault_report;                  ///< readable summary of the fault handling
+  std::vector<FaultEvent> fault_events;      ///< every detection and what was done
 };
 
 RunResult run_navigation(const RunRequest& request);

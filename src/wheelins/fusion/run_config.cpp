@@ -1,5 +1,7 @@
 #include "wheelins/fusion/run_config.hpp"
 
+#include <cmath>
+
 #include "wheelins/fusion/presets.hpp"
 #include "wheelins/io/yaml_reader.hpp"
 
@@ -16,7 +18,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   const YamlReader y(file, warn, "run configuration");
   const YAML::Node& root = y.root();
   y.check_keys(root, "", {"dataset", "configuration", "chips", "modules", "output", "duration_s",
-                          "filter", "fusion"});
+                          "filter", "fusion", "faults"});
   RunConfig c;
   const fs::path base = file.parent_path();
   auto rel = [&](const std::string& p) { return fs::path(p).is_absolute() ? fs::path(p) : base / p; };
@@ -137,6 +139,54 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     }
     if (auto v = y.get(f, "weights"); v.IsDefined()) o.weights = y.number_list(v, "fusion.weights");
     if (auto v = y.get(f, "centralized"); v.IsDefined()) o.centralized = y.boolean(v, "fusion.centralized");
+  }
+
+  if (auto f = y.get(root, "faults"); f.IsDefined()) {
+    y.require_map(f, "faults");
+    struct Key {
+      const char* name;
+      double FaultOptions::*member;
+      double unit;
+    };
+    static const Key kKeys[] = {
+        {"stale_after_s", &FaultOptions::stale_after, 1.0},
+        {"max_gap_s", &FaultOptions::max_gap, 1.0},
+        {"realign_s", &FaultOptions::realign_time, 1.0},
+        {"probation_s", &FaultOptions::probation, 1.0},
+        {"retry_after_s", &FaultOptions::retry_after, 1.0},
+        {"speed_gate_sigma", &FaultOptions::speed_gate, 1.0},
+        {"test_ratio", &FaultOptions::test_ratio, 1.0},
+        {"heading_gate_deg", &FaultOptions::heading_gate, kDeg},
+        {"saturation_margin", &FaultOptions::saturation_margin, 1.0},
+        {"saturation_hold_s", &FaultOptions::saturation_hold, 1.0}};
+    std::vector<std::string> names{"enabled", "window", "max_failed", "heading_epochs"};
+    for (const auto& k : kKeys) names.push_back(k.name);
+    y.check_keys(f, "faults", names);
+    FaultOptions& o = c.nav.faults;
+    if (auto v = y.get(f, "enabled"); v.IsDefined()) o.enabled = y.boolean(v, "faults.enabled");
+    for (const auto& k : kKeys)
+      if (auto v = y.get(f, k.name); v.IsDefined()) {
+        const std::string path = std::string("faults.") + k.name;
+        const double x = y.number(v, path);
+        y.positive(x, path, v);
+        o.*k.member = x * k.unit;
+      }
+    auto integer = [&](const char* name, int& out) {
+      if (auto v = y.get(f, name); v.IsDefined()) {
+        const std::string path = std::string("faults.") + name;
+        const double x = y.number(v, path);
+        if (x != std::floor(x) || x < 1 || x > 1000) y.fail(path, "must be a whole number >= 1", &v);
+        out = static_cast<int>(x);
+      }
+    };
+    integer("window", o.window);
+    integer("max_failed", o.max_failed);
+    integer("heading_epochs", o.heading_epochs);
+    try {
+      o.validate();
+    } catch (const InputError& e) {
+      y.fail("faults", e.what(), &f);
+    }
   }
   return c;
 }

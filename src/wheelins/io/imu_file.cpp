@@ -1,6 +1,7 @@
 #include "wheelins/io/imu_file.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "wheelins/io/atomic_file.hpp"
@@ -82,9 +83,12 @@ bool ImuFileReader::next(ImuSample& out) {
       if (dt > longest_gap_) longest_gap_ = dt;
       if (options_.warn) {
         if (gap_count_ <= static_cast<std::uint64_t>(options_.max_gap_warnings))
-          options_.warn(quote(file_) + ": record " + std::to_string(index_) + " (0-based): gap of " +
-                        format_double(dt) + " s (" + format_double(dt / nominal) +
-                        " nominal intervals) after t=" + format_double(g.t_before));
+        {
+          char buf[160];
+          std::snprintf(buf, sizeof buf, ": record %llu (0-based): gap of %.4g s (%.0f nominal intervals) after t=%.3f",
+                        static_cast<unsigned long long>(index_), dt, dt / nominal, prev_t_);
+          options_.warn(quote(file_) + buf);
+        }
         else if (gap_count_ == static_cast<std::uint64_t>(options_.max_gap_warnings) + 1)
           options_.warn(quote(file_) + ": further gaps are counted but not reported one by one");
       }

@@ -193,7 +193,8 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
   static const std::set<std::string> known = {
       "seed", "profile", "effects", "scenario", "speed_file", "duration_s", "rate_hz", "chips",
       "gps_week", "earth_rotation", "start_time_s", "origin", "static_s", "laps", "speed_m_s",
-      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "vehicle", "errors"};
+      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "vehicle", "errors",
+      "faults"};
   for (const auto& kv : node) {
     const auto k = kv.first.as<std::string>();
     if (!known.count(k)) throw InputError(where + ": unknown key '" + k + "'");
@@ -304,6 +305,16 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
         if (!found) throw InputError(key("errors") + ": unknown key '" + k + "'");
       }
     }
+    if (const auto& f = node["faults"]) {
+      // The list replaces the current one (null or [] clears it); entries are maps or
+      // `--fault` spec strings.
+      if (!f.IsNull() && !f.IsSequence())
+        throw InputError(key("faults") + ": expected a list of fault events");
+      std::vector<FaultEvent> list;
+      for (std::size_t i = 0; i < f.size(); ++i)
+        list.push_back(fault_from_yaml(f[i], key("faults[" + std::to_string(i) + "]")));
+      faults = std::move(list);
+    }
   } catch (const YAML::Exception& ex) {
     throw InputError(where + ": " + ex.what());
   }
@@ -398,6 +409,13 @@ std::string SimConfig::to_yaml() const {
     << human(errors.vib_body_band[1], kSi) << "]\n";
   o << "  vibration_wheel_band_hz: [" << human(errors.vib_wheel_band[0], kSi) << ", "
     << human(errors.vib_wheel_band[1], kSi) << "]\n";
+  // Times in seconds since the start of the data; the bias step in deg/s (gyro) or m/s^2.
+  if (faults.empty()) {
+    o << "faults: []\n";
+  } else {
+    o << "faults:  # times in seconds since the start of the data (end_s: end = to the end)\n";
+    for (const auto& f : faults) o << "  - " << f.yaml() << "\n";
+  }
   return o.str();
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "wheelins/nav/earth.hpp"
+#include "wheelins/sim/faults.hpp"
 
 namespace YAML {
 class Node;
@@ -105,6 +106,9 @@ struct SimConfig {
   std::optional<double> duration;  ///< [s] from the start; default: the whole scenario
   double rate_hz = 200.0;
   int chips = 4;
+  /// Also write the error-free streams (ideal/, manifest-ideal.yaml). An output choice,
+  /// not a setting of the data: not in scenario.yaml.
+  bool write_ideal = true;
   double gps_week = 2200;
   bool earth_rotation = true;
   VehicleConfig vehicle = VehicleConfig::preset_named("robot");
@@ -120,6 +124,9 @@ struct SimConfig {
   double terrain_slope_deg = 0.0;       ///< 0: flat
   std::optional<double> start_time;     ///< default 100000.0 (ignored with a speed file)
   std::optional<earth::Geodetic> origin;
+  /// Sensor-fault events (sim/faults.hpp), in the order given; times in seconds since the
+  /// start of the data. The YAML key `faults` replaces the list; `--fault` appends to it.
+  std::vector<FaultEvent> faults;
 
   bool on(const std::string& effect) const { return effects.count(effect) > 0; }
   /// Sets a profile: its parameters (field: gyro scale factor 3000 ppm) and its effects.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -13,6 +14,7 @@
 #include "wheelins/io/binary.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/nav/types.hpp"
+#include "wheelins/sim/faults.hpp"
 #include "wheelins/util/progress.hpp"
 
 namespace wheelins::sim {
@@ -176,13 +178,36 @@ Vibration Vibration::draw(Rng& rng, const Vec3& accel_rms, const Vec3& rate_rms,
 
 namespace {
 
-/// Forward rolling rate of a wheel, d alpha / dt, as a jet (valid to order kOrder - 2 with slip).
-J wheel_rate_jet(const ModuleModel& m, const JV& p_o, const JM& C_v) {
+/// Forward rolling rate of a wheel, d alpha / dt at time t, as a jet in t:
+///   alpha_dot = v_wc (1 + slip_coeff a_wc + sum_i s_i w_i(t)) / R,
+/// v_wc the forward speed of the wheel centre, a_wc its derivative (valid to order kOrder - 2
+/// with the slip effect: the top coefficient of a_wc is lost), s_i and w_i the ratio and the
+/// C-infinity window of each slip fault (exact jets in t, sim/faults.hpp).
+J wheel_rate_jet(const ModuleModel& m, double t, const JV& p_o, const JM& C_v) {
   const JV pwc = p_o + C_v * m.truth.p_inV;
   const J vf = dot(C_v.col(0), pwc.dot());
+  // The windows vanish with all derivatives outside (t0, t1): there the fault-free
+  // expressions below are used, so the data outside the events are bit for bit unchanged.
+  J fault(0.0);
+  bool any = false;
+  for (const auto& e : m.slip_events)
+    if (t > e.t0 && t < e.t1) {
+      fault += e.ratio * slip_window<kOrder>(t, e.t0, e.t1);
+      any = true;
+    }
+  if (any) {
+    const J slip = m.slip_coeff == 0.0 ? J(0.0) : m.slip_coeff * vf.dot();
+    return vf * (1.0 + slip + fault) / m.radius;
+  }
   if (m.slip_coeff == 0.0) return vf / m.radius;
   const J af = vf.dot();
   return vf * (1.0 + m.slip_coeff * af) / m.radius;
+}
+
+/// Forward speed of a wheel centre (rigid motion, no slip) at a time, from the v-frame jets.
+double wheel_centre_speed_of(const ModuleModel& m, const JV& p_o, const JM& C_v) {
+  const JV pwc = p_o + C_v * m.truth.p_inV;
+  return dot(C_v.col(0), pwc.dot()).value();
 }
 
 /// Vibration gain from the speed of o (see ModuleModel::vib_cruise_speed).
@@ -238,7 +263,7 @@ class GroupStepper {
     for (int i = 0; i < 4; ++i) {
       t[i] = mid + node_offset_[i];
       sim_.scenario_->evaluate(t[i], p_o[i], C_v[i]);
-      if (wheel_) rate[i] = wheel_rate_jet(m_, p_o[i], C_v[i]);
+      if (wheel_) rate[i] = wheel_rate_jet(m_, t[i], p_o[i], C_v[i]);
       if (!vib_.empty()) {
         const J gain = vibration_gain(m_, p_o[i]);
         scale(disp[i], gain);
@@ -267,7 +292,7 @@ class GroupStepper {
     JV p;
     JM C;
     sim_.scenario_->evaluate(t, p, C);
-    return wheel_rate_jet(m_, p, C);
+    return wheel_rate_jet(m_, t, p, C);
   }
 
   static J integrate(double value, const J& rate) {
@@ -480,6 +505,61 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
       chips_[g].push_back(ch);
     }
   }
+
+  // Fault events: the targets must exist and the start must lie within the data. They use no
+  // random draws. Slip faults become part of the wheel's motion (true time = start + time).
+  const double span = data_duration();
+  for (const FaultEvent& f : cfg_.faults) {
+    const std::string what = "fault '" + f.spec() + "': ";
+    if (f.target.find("-C") != std::string::npos) {
+      const int n = std::stoi(f.target.substr(f.target.find("-C") + 2));
+      if (n > cfg_.chips)
+        throw InputError(what + "no chip " + f.target + " (the dataset has " + std::to_string(cfg_.chips) +
+                         " chip" + (cfg_.chips == 1 ? "" : "s") + " per module: C1..C" +
+                         std::to_string(cfg_.chips) + ")");
+    }
+    if (!(f.start < span))
+      throw InputError(what + "the start " + num(f.start) + " s is outside the data (0 to " + num(span) +
+                       " s since the start of the data)");
+    if (f.kind == FaultKind::kSlip) {
+      ModuleModel::SlipEvent e;
+      e.t0 = start_time() + f.start;
+      e.t1 = f.end ? start_time() + *f.end : std::numeric_limits<double>::infinity();
+      e.ratio = f.ratio;
+      modules_[f.target == "left-wheel" ? 0 : 1].slip_events.push_back(e);
+    }
+  }
+}
+
+double Simulation::data_duration() const {
+  // The writer's sample count K: the last sample is stamped start + K / rate.
+  const double K = std::floor((end_ - start_time()) * cfg_.rate_hz + 1e-6);
+  return K / cfg_.rate_hz;
+}
+
+double Simulation::wheel_rate(int g, double t) const {
+  if (!modules_[g].truth.wheel) return 0.0;
+  return GroupStepper(*this, g, 0.0).rate_at(t).value();
+}
+
+double Simulation::slip_extra_angle(int g, const ModuleModel::SlipEvent& e) const {
+  // alpha_dot - (fault-free alpha_dot) = ratio * w(t) * v_wc(t) / R (see wheel_rate_jet);
+  // 4-point Gauss-Legendre over steps of one sample interval from t0 (w is C-infinity).
+  const ModuleModel& m = modules_[g];
+  const double h = 1.0 / cfg_.rate_hz, b_end = std::min(e.t1, end_);
+  double sum = 0.0;
+  for (double a = e.t0; a < b_end; a += h) {
+    const double b = std::min(a + h, b_end);
+    for (int i = 0; i < 4; ++i) {
+      const double t = 0.5 * (a + b) + 0.5 * (b - a) * kGlX[i];
+      JV p_o;
+      JM C_v;
+      scenario_->evaluate(t, p_o, C_v);
+      sum += 0.5 * (b - a) * kGlW[i] * e.ratio * slip_window<kOrder>(t, e.t0, e.t1).value() *
+             wheel_centre_speed_of(m, p_o, C_v) / m.radius;
+    }
+  }
+  return sum;
 }
 
 ImuTruth Simulation::truth(int g, double t) const {
@@ -503,12 +583,11 @@ ImuTruth Simulation::truth(int g, double t) const {
   ImuTruth r;
   J alpha_jet(0.0);
   if (m.truth.wheel) {
-    const J rate = wheel_rate_jet(m, p_o, C_v);
+    const J rate = wheel_rate_jet(m, t, p_o, C_v);
     alpha_jet = GroupStepper::integrate(alpha, rate);
     r.wheel_angle = alpha;
     r.wheel_rate = rate.value();
-    const JV pwc = p_o + C_v * m.truth.p_inV;
-    r.wheel_centre_speed = dot(C_v.col(0), pwc.dot()).value();
+    r.wheel_centre_speed = wheel_centre_speed_of(m, p_o, C_v);
   }
   st.imu_jets(t, p_o, C_v, alpha_jet, p, C_s);
   r.p_inN = p.deriv(0);
@@ -556,10 +635,11 @@ ImuNoise datasheet_noise() {
 }
 
 /// One manifest module of group `group` with the given geometry and rolling radius
-/// (the chip manifest states the calibrated geometry, the ideal manifest the truth).
+/// (the chip manifest states the calibrated geometry, the ideal manifest the truth) and the
+/// gyro full scale (0: not stated).
 ModuleSpec module_spec(const ModuleGeometry& geo, double radius, const std::string& name,
                        const std::string& group, const std::string& chip, const fs::path& file,
-                       double rate_hz) {
+                       double rate_hz, double gyro_range) {
   ModuleSpec s;
   s.name = name;
   s.kind = geo.wheel ? ModuleKind::kWheel : ModuleKind::kBody;
@@ -572,10 +652,18 @@ ModuleSpec module_spec(const ModuleGeometry& geo, double radius, const std::stri
   s.mounting_rpy = geo.mounting_rpy;
   s.axle_sign = 1;
   s.wheel_radius = geo.wheel ? radius : 0.0;
+  s.gyro_range = gyro_range;
   s.noise = datasheet_noise();
   return s;
 }
 }  // namespace
+
+double Simulation::gyro_range() const {
+  // The chips' gyro full scale, stated when the saturation effect clips at it. The ideal
+  // manifest states it too: it is a property of the chips (their data saturate there), and a
+  // filter run on the error-free streams then flags the same instants as on the chip data.
+  return cfg_.on("saturation") ? cfg_.errors.gyro_range : 0.0;
+}
 
 Manifest Simulation::manifest() const {
   Manifest m = ideal_manifest();
@@ -587,7 +675,7 @@ Manifest Simulation::manifest() const {
       const std::string chip = ch.name.substr(ch.name.find('-') + 1);
       m.modules.push_back(module_spec(mm.manifest, mm.radius_manifest, ch.name, group_name(g), chip,
                                       fs::path(group_dir(g)) / ("tri_" + chip + "_imu.bin"),
-                                      cfg_.rate_hz));
+                                      cfg_.rate_hz, gyro_range()));
     }
   }
   return m;
@@ -612,7 +700,7 @@ Manifest Simulation::ideal_manifest() const {
     m.modules.push_back(module_spec(
         mm.truth, mm.radius, std::string(g == 0 ? "left" : g == 1 ? "right" : "body") + "-ideal",
         group_name(g), "ideal", fs::path("ideal") / (std::string(group_name(g)) + "_imu.bin"),
-        cfg_.rate_hz));
+        cfg_.rate_hz, gyro_range()));
   }
   return m;
 }
@@ -681,6 +769,42 @@ std::string Simulation::errors_yaml() const {
       o << "        accel_tempco_m_s2_per_K: " << vec(c.accel_tempco) << "\n";
     }
   }
+  // Fault events: what each one did, with its interval as stamps (sensor faults act on the
+  // stamped samples) or true times (slip acts on the motion).
+  if (cfg_.faults.empty()) {
+    o << "faults: []\n";
+    return o.str();
+  }
+  o << "faults:  # times since the start of the data " << num(start_time())
+    << " s; sensor faults act on the samples stamped in [start, end)\n";
+  int slip_index[2] = {0, 0};
+  for (const FaultEvent& f : cfg_.faults) {
+    o << "  - spec: \"" << f.spec() << "\"\n";
+    std::string chips;
+    for (int g = 0; g < kGroups; ++g)
+      for (const ChipModel& c : chips_[g])
+        if (f.targets(group_name(g), c.name)) chips += (chips.empty() ? "" : ", ") + c.name;
+    o << "    chips: [" << chips << "]\n";
+    const std::string end = f.end ? num(start_time() + *f.end) : std::string("end");
+    if (f.kind == FaultKind::kSlip) {
+      const int g = f.target == "left-wheel" ? 0 : 1;
+      const ModuleModel::SlipEvent& e = modules_[g].slip_events[slip_index[g]++];
+      const double ramp = std::isfinite(e.t1) ? std::min(kSlipRamp, 0.5 * (e.t1 - e.t0)) : kSlipRamp;
+      o << "    true_time_s: [" << num(e.t0) << ", " << end << "]  # also the error-free stream "
+        << group_name(g) << "\n";
+      o << "    ramp_s: " << num(ramp) << "  # C-infinity ramps inside the interval\n";
+      o << "    extra_wheel_angle_rad: " << num(slip_extra_angle(g, e))
+        << "  # integral of ratio * w(t) * v_wheel_centre / R within the data\n";
+      continue;
+    }
+    o << "    stamps_s: [" << num(start_time() + f.start) << ", " << end << "]\n";
+    if (f.kind == FaultKind::kGyroBiasJump || f.kind == FaultKind::kAccelBiasJump) {
+      Vec3 step = Vec3::Zero();
+      step[f.axis] = f.value_si();
+      o << "    " << (f.gyro ? "gyro_bias_step_rad_s: " : "accel_bias_step_m_s2: ") << vec(step)
+        << "  # added to the bias (and to errors/<chip>_bias.bin)\n";
+    }
+  }
   return o.str();
 }
 
@@ -705,13 +829,17 @@ class ChipErrors {
     s_vrw_ = e_.accel_vrw / std::sqrt(dt);
   }
   /// Advances the processes by one sample and corrupts the true mean rates.
-  void apply(double dT, const Vec3& w, const Vec3& f, Vec3& wm, Vec3& fm) {
+  /// `gyro_step` / `accel_step` (may be null): bias-jump faults added to the bias.
+  void apply(double dT, const Vec3& w, const Vec3& f, Vec3& wm, Vec3& fm, const Vec3* gyro_step = nullptr,
+             const Vec3* accel_step = nullptr) {
     if (on_gm_g_)
       for (int i = 0; i < 3; ++i) bg_gm_[i] = phi_g_ * bg_gm_[i] + q_g_ * gm_g_.normal();
     if (on_gm_a_)
       for (int i = 0; i < 3; ++i) ba_gm_[i] = phi_a_ * ba_gm_[i] + q_a_ * gm_a_.normal();
     bg_ = m_.gyro_bias + bg_gm_ + m_.gyro_tempco * dT;
     ba_ = m_.accel_bias + ba_gm_ + m_.accel_tempco * dT;
+    if (gyro_step) bg_ += *gyro_step;
+    if (accel_step) ba_ += *accel_step;
     wm = m_.gyro_T * w + bg_;
     fm = m_.accel_T * f + ba_;
     for (int i = 0; i < 3; ++i) {
@@ -739,6 +867,60 @@ class ChipErrors {
   double phi_g_, q_g_, phi_a_, q_a_, s_arw_, s_vrw_;
 };
 
+/// The sensor-fault events of one chip, applied to its output samples in the writer.
+class ChipFaults {
+ public:
+  ChipFaults(const std::vector<FaultEvent>& faults, const std::string& group, const std::string& chip) {
+    for (const FaultEvent& f : faults) {
+      if (!f.targets(group, chip)) continue;
+      if (f.kind == FaultKind::kDropout) dropouts_.push_back(&f);
+      if (f.kind == FaultKind::kGyroBiasJump || f.kind == FaultKind::kAccelBiasJump) jumps_.push_back(&f);
+      if (f.kind == FaultKind::kStuck) stuck_.push_back({&f, 0.0, false});
+    }
+  }
+  /// The bias steps active at `tau` (seconds since the start of the data); false if none.
+  bool steps(double tau, Vec3& gyro, Vec3& accel) const {
+    bool any = false;
+    gyro.setZero();
+    accel.setZero();
+    for (const FaultEvent* f : jumps_)
+      if (f->active(tau)) {
+        (f->gyro ? gyro : accel)[f->axis] += f->value_si();
+        any = true;
+      }
+    return any;
+  }
+  /// Stuck axes: during the event the axis repeats the last output before its start (the
+  /// first output if the event starts before the first sample).
+  void hold(double tau, Vec3& wm, Vec3& fm) {
+    for (Stuck& s : stuck_) {
+      double& x = (s.f->gyro ? wm : fm)[s.f->axis];
+      if (s.f->active(tau)) {
+        if (!s.have) s.value = x, s.have = true;
+        x = s.value;
+      } else if (tau < s.f->start) {
+        s.value = x;
+        s.have = true;
+      }
+    }
+  }
+  /// True if no sample is written at `tau`.
+  bool dropped(double tau) const {
+    for (const FaultEvent* f : dropouts_)
+      if (f->active(tau)) return true;
+    return false;
+  }
+
+ private:
+  struct Stuck {
+    const FaultEvent* f;
+    double value;
+    bool have;
+  };
+  std::vector<const FaultEvent*> dropouts_, jumps_;
+  std::vector<Stuck> stuck_;
+};
+
 std::uint64_t file_bytes(const fs::path& p) {
   std::error_code ec;
   const auto n = fs::file_size(p, ec);
@@ -764,7 +946,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
   fs::create_directories(dir, ec);
   if (ec) throw InputError("'" + dir.string() + "': cannot create: " + ec.message());
   for (int g = 0; g < kGroups; ++g) fs::create_directories(dir / group_dir(g));
-  fs::create_directories(dir / "ideal");
+  if (cfg_.write_ideal) fs::create_directories(dir / "ideal");
   fs::create_directories(dir / "errors");
 
   const double t0 = start_time();
@@ -783,10 +965,15 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
       GroupStepper st(*this, g, m.time_offset);
       std::unique_ptr<GroupStepper> ideal;
       if (m.time_offset != 0.0) ideal = std::make_unique<GroupStepper>(*this, g, 0.0);
-      BinaryRowWriter ideal_out(dir / "ideal" / (std::string(group_name(g)) + "_imu.bin"), 7);
+      std::unique_ptr<BinaryRowWriter> ideal_out;
+      if (cfg_.write_ideal)
+        ideal_out = std::make_unique<BinaryRowWriter>(
+            dir / "ideal" / (std::string(group_name(g)) + "_imu.bin"), 7);
       std::vector<std::unique_ptr<BinaryRowWriter>> outs, bias_outs;
       std::vector<std::unique_ptr<ChipErrors>> errs;
+      std::vector<ChipFaults> faults;
       for (const ChipModel& c : chips_[g]) {
+        faults.emplace_back(cfg_.faults, group_name(g), c.name);
         const std::string chip = c.name.substr(c.name.find('-') + 1);
         outs.push_back(std::make_unique<BinaryRowWriter>(dir / group_dir(g) / ("tri_" + chip + "_imu.bin"), 7));
         bias_outs.push_back(std::make_unique<BinaryRowWriter>(dir / "errors" / (c.name + "_bias.bin"), 7));
@@ -801,13 +988,19 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
         else wi = w, fi = f;
         row[0] = b;
         for (int i = 0; i < 3; ++i) row[1 + i] = wi[i], row[4 + i] = fi[i];
-        ideal_out.write(row);
+        if (ideal_out) ideal_out->write(row);
         const double dT = m.temp_rise * (1.0 - std::exp(-(b + m.time_offset - t0) / cfg_.errors.temp_tau));
+        // Sample k is at tau = k / rate since the start of the data (fault times).
+        const double tau = static_cast<double>(k) / rate;
         for (std::size_t c = 0; c < errs.size(); ++c) {
-          Vec3 wm, fm;
-          errs[c]->apply(dT, w, f, wm, fm);
+          Vec3 wm, fm, step_g, step_a;
+          // The error model runs on every sample (a dropout or a stuck axis draws the same
+          // random numbers), so the data after a sensor fault equal the fault-free run's.
+          if (faults[c].steps(tau, step_g, step_a)) errs[c]->apply(dT, w, f, wm, fm, &step_g, &step_a);
+          else errs[c]->apply(dT, w, f, wm, fm);
+          faults[c].hold(tau, wm, fm);
           for (int i = 0; i < 3; ++i) row[1 + i] = wm[i], row[4 + i] = fm[i];
-          outs[c]->write(row);
+          if (!faults[c].dropped(tau)) outs[c]->write(row);
           if (k % per_second == 0) {
             const Vec3& bg = errs[c]->gyro_bias();
             const Vec3& ba = errs[c]->accel_bias();
@@ -817,7 +1010,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
         }
         if ((k & 255) == 0) done += 256;
       }
-      ideal_out.commit();
+      if (ideal_out) ideal_out->commit();
       for (auto& o : outs) o->commit();
       for (auto& o : bias_outs) o->commit();
     } catch (...) {
@@ -872,7 +1065,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
   ManifestAnnotations notes;
   notes.header = {"simulated by wheelins simulate; settings in scenario.yaml, drawn errors in errors.yaml",
                   scenario_->describe()};
-  save_manifest(ideal_manifest(), dir / "manifest-ideal.yaml", notes);
+  if (cfg_.write_ideal) save_manifest(ideal_manifest(), dir / "manifest-ideal.yaml", notes);
   save_manifest(manifest(), dir / "manifest.yaml", notes);
 
   DatasetSummary sum;

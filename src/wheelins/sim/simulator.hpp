@@ -50,11 +50,17 @@ struct Vibration {
 
 /// One physical module as simulated (the truth) and as the manifest states it.
 struct ModuleModel {
+  /// A wheel-slip fault event (sim/faults.hpp) in true (scenario) time: the rolling rate is
+  /// multiplied by 1 + ratio * w(t), w = slip_window over [t0, t1] (t1 = +inf: open-ended).
+  struct SlipEvent {
+    double t0 = 0.0, t1 = 0.0, ratio = 0.0;
+  };
   ModuleGeometry truth;        ///< geometry used to simulate
   ModuleGeometry manifest;     ///< geometry written to manifest.yaml (calibration residuals)
   double radius = 0.0;         ///< true effective rolling radius (wheel) [m]
   double radius_manifest = 0.0;
   double slip_coeff = 0.0;     ///< [s^2/m], 0 without the slip effect
+  std::vector<SlipEvent> slip_events;  ///< slip faults of this wheel
   double time_offset = 0.0;    ///< true clock offset: a sample stamped t covers (t-dt+off, t+off]
   double temp_rise = 0.0;      ///< [K]
   Vibration vibration;
@@ -106,6 +112,9 @@ class Simulation {
   const Scenario& scenario() const { return *scenario_; }
   double start_time() const { return scenario_->start_time(); }
   double end_time() const { return end_; }
+  /// The length of the data [s]: the last IMU sample is stamped start_time() + data_duration()
+  /// (fault times count from start_time(); sample k is at k / rate).
+  double data_duration() const;
   double speed_scale() const { return speed_scale_; }
   const ModuleModel& module(int g) const { return modules_[g]; }
   const std::vector<ChipModel>& chips(int g) const { return chips_[g]; }
@@ -115,6 +124,12 @@ class Simulation {
   /// The true motion of module g's sensor at true time t (wheel angle integrated
   /// from the start by Gauss-Legendre quadrature).
   ImuTruth truth(int g, double t) const;
+  /// The wheel's rotation rate d alpha / dt at true time t (rolling rate with the slip effect
+  /// and slip faults) [rad/s]; the wheel angle is its integral from start_time().
+  double wheel_rate(int g, double t) const;
+  /// The extra wheel angle of slip fault `e` of wheel g: integral of ratio * w(t) * v_wc / R
+  /// over the event within the data [rad] (Gauss-Legendre on the sample grid).
+  double slip_extra_angle(int g, const ModuleModel::SlipEvent& e) const;
 
   /// Error-free mean samples of module g over the sample grid, for k = 1..count
   /// (interval (t_{k-1}, t_k], t_k = start + k / rate), without the clock offset.
@@ -123,6 +138,9 @@ class Simulation {
   /// The manifests of the dataset (paths relative to the dataset directory).
   Manifest manifest() const;
   Manifest ideal_manifest() const;
+  /// The gyro full scale both manifests state [rad/s]: errors.gyro_range with the saturation
+  /// effect on, else 0 (not stated).
+  double gyro_range() const;
 
   /// Writes the dataset into `dir` (see docs/simulator.md). Refuses a non-empty `dir`
   /// unless `force`. Shows progress on a terminal when `progress`.
