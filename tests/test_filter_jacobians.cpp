@@ -239,3 +239,86 @@ TEST(FilterJacobian, ReferencePointOfLevelWheelAndBody) {
   b.p_IinW = o + rot_z(psi) * b.p_inV;
   EXPECT_NEAR((reference_point_model(b).r_o - o).norm(), 0.0, 1e-12);
 }
+
+// The centralized filter's cross-terms (Section VI-B-2): a Wheel-INS measurement depends on
+// the Body-INS attitude through the shared vehicle level (eq. 5, theta_3 and phi_3).
+
+TEST(FilterJacobian, WheelVelocityAndReferencePointLevelJacobians) {
+  for (double roll : {0.02, -0.3}) {
+    const NavTruth t;
+    WheelVelocityInput base = wheel_input(perturb(t, Vec21::Zero()), -14.0);
+    base.vehicle_roll = roll;
+    ReferencePointInput rp;
+    rp.C_BtoW = t.C;
+    rp.p_IinW = t.p;
+    rp.lever_arm_inB = Vec3(0.004, -0.003, 0.005);
+    rp.p_inV = Vec3(0.01, -0.165, 0.02);
+    rp.vehicle_roll = base.vehicle_roll;
+    rp.vehicle_pitch = base.vehicle_pitch;
+    const WheelVelocityModel m = wheel_velocity_model(base);
+    const ReferencePointModel r = reference_point_model(rp);
+    const double eps = 1e-6;
+    for (int k = 0; k < 2; ++k) {
+      auto vel_at = [&](double s) {
+        WheelVelocityInput in = base;
+        (k == 0 ? in.vehicle_roll : in.vehicle_pitch) += s;
+        return wheel_velocity_model(in).z_hat;
+      };
+      auto ro_at = [&](double s) {
+        ReferencePointInput in = rp;
+        (k == 0 ? in.vehicle_roll : in.vehicle_pitch) += s;
+        return reference_point_model(in).r_o;
+      };
+      const Vec3 dv = (vel_at(eps) - vel_at(-eps)) / (2 * eps);
+      const Vec3 dr = (ro_at(eps) - ro_at(-eps)) / (2 * eps);
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(dv(i), m.H_level(i, k), 1e-7 * (1.0 + std::abs(m.H_level(i, k))))
+            << "velocity roll " << roll << " (" << i << "," << k << ")";
+        EXPECT_NEAR(dr(i), r.H_level(i, k), 1e-8) << "reference point (" << i << "," << k << ")";
+      }
+    }
+    EXPECT_GT(m.H_level.cwiseAbs().maxCoeff(), 1e-2);
+    EXPECT_GT(r.H_level.cwiseAbs().maxCoeff(), 1e-3);
+  }
+  // A Body-IMU's o does not depend on a shared level.
+  ReferencePointInput b;
+  b.wheel = false;
+  EXPECT_EQ(reference_point_model(b).H_level.cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(FilterJacobian, VehicleLevelSensitivityMatchesFiniteDifference) {
+  // Roll/pitch of C_v^w = C_b^w C_v^b of a Body-IMU under its attitude error
+  // (C_hat = exp(-[phi x]) C), and the chain into a Wheel-INS innovation (the Body-INS
+  // block of the centralized H).
+  const Mat3 C_BtoV = dcm_from_euler(Vec3(0.5, -0.8, 1.2) * kDeg);
+  const Mat3 C_body = dcm_from_euler(Vec3(0.03, -0.05, 2.1)) * C_BtoV;
+  const Mat3 C_VtoW = C_body * C_BtoV.transpose();
+  const Eigen::Matrix<double, 2, 3> L = vehicle_level_sensitivity(C_VtoW);
+  const NavTruth t;
+  WheelVelocityInput base = wheel_input(perturb(t, Vec21::Zero()), -14.0);
+  auto level_at = [&](const Vec3& phi) {
+    const Vec3 rpy = euler_from_dcm(dcm_from_rotvec(-phi) * C_body * C_BtoV.transpose());
+    return Eigen::Vector2d(rpy.x(), rpy.y());
+  };
+  auto innovation_at = [&](const Vec3& phi) {
+    const Eigen::Vector2d lv = level_at(phi);
+    WheelVelocityInput in = base;
+    in.vehicle_roll = lv.x();
+    in.vehicle_pitch = lv.y();
+    return wheel_velocity_model(in).innovation();
+  };
+  const Eigen::Vector2d lv0 = level_at(Vec3::Zero());
+  base.vehicle_roll = lv0.x();
+  base.vehicle_pitch = lv0.y();
+  const Eigen::Matrix<double, 3, 3> H_body = wheel_velocity_model(base).H_level * L;
+  const double eps = 1e-6;
+  for (int j = 0; j < 3; ++j) {
+    Vec3 dphi = Vec3::Zero();
+    dphi(j) = eps;
+    const Eigen::Vector2d col = (level_at(dphi) - level_at(-dphi)) / (2 * eps);
+    const Vec3 hcol = (innovation_at(dphi) - innovation_at(-dphi)) / (2 * eps);
+    for (int i = 0; i < 2; ++i) EXPECT_NEAR(col(i), L(i, j), 1e-8) << "L(" << i << "," << j << ")";
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(hcol(i), H_body(i, j), 1e-7) << "H_body(" << i << "," << j << ")";
+  }
+}

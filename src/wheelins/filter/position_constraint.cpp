@@ -18,6 +18,10 @@ ReferencePointModel reference_point_model(const ReferencePointInput& in) {
     const Eigen::RowVector3d dpsi_dphi = wheel_heading_sensitivity(C);
     const Vec3 dRa_dpsi = Rz * skew(Vec3::UnitZ()) * a;
     m.H.block<3, 3>(0, PHI) = skew(Cl) - dRa_dpsi * dpsi_dphi;
+    // Eq. (8) with C_v^w = Rz Ry(theta) Rx(phi): d(Ry Rx)/d phi = Ry Rx [e_x x], d/d theta = Ry [e_y x] Rx.
+    const Mat3 Rx = rot_x(in.vehicle_roll), Ry = rot_y(in.vehicle_pitch);
+    m.H_level.col(0) = -Rz * Ry * Rx * skew(Vec3::UnitX()) * in.p_inV;
+    m.H_level.col(1) = -Rz * Ry * skew(Vec3::UnitY()) * Rx * in.p_inV;
   } else {
     // r_o = r_b - C_b^w C_v^b r_b^v; (I - [phi x]) C_v^w r = C_v^w r + [(C_v^w r) x] phi.
     const Vec3 Cr = C * in.C_BtoV.transpose() * in.p_inV;

@@ -27,6 +27,9 @@ struct ReferencePointInput {
 struct ReferencePointModel {
   Vec3 r_o = Vec3::Zero();  ///< o in the w-frame, eq. (8)
   Eigen::Matrix<double, 3, kStateDim> H = Eigen::Matrix<double, 3, kStateDim>::Zero();  ///< H_mlt
+  /// Wheel-IMU: d r_o / d [vehicle roll, pitch] (the level shared by a Body-INS); zero for a
+  /// Body-IMU, whose C_v^w is its own attitude.
+  Eigen::Matrix<double, 3, 2> H_level = Eigen::Matrix<double, 3, 2>::Zero();
 };
 
 ReferencePointModel reference_point_model(const ReferencePointInput& in);

@@ -26,6 +26,7 @@ void StrapdownEkf::propagate_nominal(const ImuSample& raw) {
   const ImuSample cur = compensate(raw, errors_);
   mechanize(mech_, have_last_ ? last_ : cur, cur, state_);
   last_ = cur;
+  last_raw_ = raw;
   have_last_ = true;
   dyn_ = error_dynamics_blocks(state_.C_ItoW(), cur.dtheta / cur.dt, cur.dvel / cur.dt,
                               mech_.omega_ie_inW, noise_);

@@ -55,8 +55,10 @@ class StrapdownEkf {
   const ImuErrors& errors() const { return errors_; }
   const Mat21& covariance() const { return P_; }
   Mat21& covariance() { return P_; }
-  /// The last compensated sample, as rates [rad/s], [m/s^2].
-  Vec3 omega_ib_b() const { return last_.dtheta / last_.dt; }
+  /// The last sample compensated with the current error estimates, as rates [rad/s],
+  /// [m/s^2] (after a feedback, the corrected estimates apply: measurement models evaluated
+  /// between two epochs, e.g. a centralized filter's sequential updates, stay consistent).
+  Vec3 omega_ib_b() const { return compensate(last_raw_, errors_).dtheta / last_raw_.dt; }
   Vec3 f_b() const { return last_.dvel / last_.dt; }
   const ImuSample& last_compensated() const { return last_; }
   const MechanizationOptions& mechanization() const { return mech_; }
@@ -75,6 +77,7 @@ class StrapdownEkf {
   ProcessNoise noise_;
   MechanizationOptions mech_;
   ImuSample last_;
+  ImuSample last_raw_;
   bool have_last_ = false;
   bool initialized_ = false;
   bool own_covariance_ = true;

@@ -80,7 +80,10 @@ double WheelIns::ins_speed() const {
 
 void WheelIns::propagate(const ImuSample& body_sample) {
   ekf_.propagate(body_sample);
-  const double wx = ekf_.omega_ib_b().x();
+  // The window keeps the uncompensated rate; mean_omega_x() compensates it with the current
+  // estimates, so the speed stays consistent with the error state after every feedback
+  // (a centralized filter corrects this IMU's b_g,x / s_g,x between two updates of one epoch).
+  const double wx = body_sample.dtheta.x() / body_sample.dt;
   if (window_count_ == window_len_) window_sum_ -= window_[window_pos_];
   else ++window_count_;
   window_[window_pos_] = wx;
@@ -89,7 +92,16 @@ void WheelIns::propagate(const ImuSample& body_sample) {
 }
 
 double WheelIns::mean_omega_x() const {
-  return window_count_ ? window_sum_ / window_count_ : 0.0;
+  if (!window_count_) return 0.0;
+  const ImuErrors& e = ekf_.errors();
+  return (window_sum_ / window_count_ - e.bg.x()) / (1.0 + e.sg.x());
+}
+
+WheelIns::SpeedSensitivity WheelIns::speed_sensitivity() const {
+  WheelVelocityInput in;
+  in.axle_sign = axle_sign_;
+  set_own_wheel_speed(in, module_.wheel_radius, mean_omega_x());
+  return {in.dspeed_dbgx, in.dspeed_dsgx};
 }
 
 double WheelIns::wheel_speed() const { return -axle_sign_ * module_.wheel_radius * mean_omega_x(); }

@@ -39,6 +39,11 @@ class WheelIns final : public Subsystem {
   /// This wheel's forward speed from the mean compensated gyro x over the window [m/s].
   double wheel_speed() const;
   double mean_omega_x() const;
+  /// d(wheel_speed) / d(b_g,x) and d / d(s_g,x) of this IMU's residual gyro errors.
+  struct SpeedSensitivity {
+    double dbgx = 0.0, dsgx = 0.0;
+  };
+  SpeedSensitivity speed_sensitivity() const;
   /// The b-frame x rate this wheel turns at when rolling at `speed` [rad/s].
   double omega_x_at_speed(double speed) const { return -axle_sign_ * speed / module_.wheel_radius; }
   /// Vehicle yaw rate (w-frame z, down: positive turning right) from this gyro less its

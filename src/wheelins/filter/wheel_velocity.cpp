@@ -20,6 +20,17 @@ Eigen::RowVector3d wheel_heading_sensitivity(const Mat3& C) {
   return Eigen::RowVector3d(-c1.y() / h2, c1.x() / h2, 0.0) * skew(c1);
 }
 
+Eigen::Matrix<double, 2, 3> vehicle_level_sensitivity(const Mat3& C) {
+  // C = Rz(psi) Ry(theta) Rx(phi): omega^w = psi' e_z + theta' Rz e_y + phi' Rz Ry e_x, so
+  // phi' = (cos psi w_x + sin psi w_y) / cos theta, theta' = -sin psi w_x + cos psi w_y.
+  // exp(-[phi x]) C is a w-frame rotation by -phi.
+  const Vec3 e = euler_from_dcm(C);
+  const double cp = std::cos(e.z()), sp = std::sin(e.z()), ct = std::cos(e.y());
+  Eigen::Matrix<double, 2, 3> M;
+  M << cp / ct, sp / ct, 0.0, -sp, cp, 0.0;
+  return -M;
+}
+
 WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   const Mat3& C = in.C_BtoW;
   const Vec3& l = in.lever_arm_inB;
@@ -55,6 +66,11 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   // The measured speed comes from the same compensated gyro: dz = z_hat - z_meas.
   m.H(0, BG) -= in.dspeed_dbgx;
   m.H(0, SG) -= in.dspeed_dsgx;
+  // z_hat = Rx(phi)^T Ry(theta)^T Rz^T u; d Rx^T/d phi = -[e_x x] Rx^T, same for Ry.
+  const Mat3 Rx = rot_x(in.vehicle_roll), Ry = rot_y(in.vehicle_pitch);
+  m.H_level.col(0) = -skew(Vec3::UnitX()) * C_WtoV * u;
+  m.H_level.col(1) = -Rx.transpose() * skew(Vec3::UnitY()) * Ry.transpose() * Rz.transpose() * u;
+
   return m;
 }
 

@@ -40,8 +40,17 @@ struct WheelVelocityModel {
   Vec3 z_hat = Vec3::Zero();   ///< predicted wheel-centre velocity in the v-frame
   Vec3 z_meas = Vec3::Zero();  ///< measured [speed, 0, 0]
   Eigen::Matrix<double, 3, kStateDim> H = Eigen::Matrix<double, 3, kStateDim>::Zero();
+  /// d z_hat / d [vehicle roll, pitch]: the level is not this IMU's state but the one a
+  /// Body-INS shares (Section V-A, theta_3, phi_3 in eq. 5); a centralized filter maps it
+  /// onto the Body-INS attitude error with vehicle_level_sensitivity().
+  Eigen::Matrix<double, 3, 2> H_level = Eigen::Matrix<double, 3, 2>::Zero();
   Vec3 innovation() const { return z_hat - z_meas; }
 };
+
+/// d [roll, pitch] / d phi of the vehicle attitude C_v^w = Rz(psi) Ry(theta) Rx(phi) under
+/// the attitude error of the IMU that carries it (C_hat = exp(-[phi x]) C, phi in the
+/// w-frame): minus the map from a w-frame rotation vector to Euler-angle increments.
+Eigen::Matrix<double, 2, 3> vehicle_level_sensitivity(const Mat3& C_VtoW);
 
 /// Vehicle heading implied by a Wheel-IMU attitude: yaw of the b x-axis - axle_sign * 90 deg.
 double wheel_vehicle_heading(const Mat3& C_BtoW, int axle_sign);

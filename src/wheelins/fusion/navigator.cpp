@@ -67,6 +67,7 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
                          body_->module().name + "' is already selected");
       auto b = std::make_unique<BodyIns>(*m, opt_.body, mech);
       body_ = b.get();
+      body_index_ = static_cast<int>(subs_.size());
       subs_.push_back(std::move(b));
     }
   }
@@ -217,25 +218,232 @@ void Navigator::start_navigation(double t0) {
   next_position_t_ = t0 + opt_.fusion.position_update_interval;
 }
 
+bool Navigator::level_shared() const {
+  // The Body-INS level is shared only while the Body-INS counts (a module on probation or
+  // out does not pass its attitude on; the wheels keep the last level they were given).
+  return body_ && opt_.fusion.share_level && counted(body_index_);
+}
+
+void Navigator::share_level() {
+  if (!level_shared()) return;
+  const Vec3 rpy = body_->vehicle_rpy();
+  for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
+}
+
+void Navigator::add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
+                                std::array<H3, kMaxCentralized>& h) const {
+  if (!level_shared() || c == 0.0) return;
+  h[body_index_].block<3, 3>(0, PHI) +=
+      c * H_level * vehicle_level_sensitivity(body_->C_VtoW());
+}
+
+void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
+  // The same measurements as the distributed filter (eq. 5 for a Wheel-INS, eq. 6 for the
+  // Body-INS, with the fault handling's choice of speeds), but one EKF over all error states
+  // (Section VI-B-2), so every dependence on another IMU's state is in H instead of being
+  // ignored:
+  //  - the mean wheel speed (1/n) sum_j (-a_j r_j omega_x,j) over the wheels in the mean
+  //    (counted, speed usable: speeds_.in_mean, n = speeds_.n_mean) carries each of those
+  //    Wheel-IMUs' r delta omega_x of eq. (3): -(1/n) dspeed_j/d(b_g,x, s_g,x) in block j
+  //    (dz = z_hat - z_meas), also when it replaces a wheel's own unusable speed;
+  //  - a Wheel-INS model uses the Body-INS roll/pitch (eq. 5, theta_3 and phi_3): its
+  //    H_level times d(roll, pitch)/d(phi_3) in the Body-INS block.
+  // Everything is evaluated at the current state: the speeds from the current gyro-x
+  // estimates, the level from the current Body-INS attitude. Which speeds are usable is
+  // decided once per update epoch (velocity_updates()).
+  const int N = subsystem_count();
+  const SpeedSelection& sel = speeds_;
+  const int n_mean = sel.n_mean;
+  double mean_speed = 0.0;
+  Vec3 mean_point = Vec3::Zero();
+  for (int j = 0; j < N; ++j)
+    if (sel.in_mean[j]) {
+      const auto& w = static_cast<const WheelIns&>(*subs_[j]);
+      mean_speed += w.wheel_speed();
+      mean_point += w.module().p_inV;
+    }
+  if (n_mean) {
+    mean_speed /= n_mean;
+    mean_point /= n_mean;
+  }
+  for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
+  bool mean = false;  // the measured speed is the mean: its sensitivities are added below
+  if (subs_[i]->is_wheel()) {
+    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
+    WheelVelocityInput in = w.own_velocity_input();
+    if (level_shared()) {
+      const Vec3 rpy = body_->vehicle_rpy();
+      in.vehicle_roll = rpy.x();
+      in.vehicle_pitch = rpy.y();
+    }
+    jm.R = w.velocity_noise();
+    if (sel.speed_ok[i]) {
+      // Its own speed (in.dspeed_* stay this IMU's), or the mean it is part of.
+      mean = opt_.fusion.speed == SpeedSharing::kMean && n_mean > 1 && sel.in_mean[i];
+    } else if (n_mean > 0) {
+      mean = true;  // its own speed is unusable: the mean of the others'
+    } else {
+      // No speed at all: the NHC rows only.
+      in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+      jm.R(0, 0) = kNoSpeedVar;
+    }
+    if (mean) {
+      in.measured_speed = mean_speed;
+      in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+    }
+    const WheelVelocityModel m = wheel_velocity_model(in);
+    jm.H[i] = m.H;
+    add_level_block(m.H_level, 1.0, jm.H);
+    jm.dz = m.innovation();
+    if (mean) {
+      // The mean of the wheel speeds is the speed of the mean of the wheel centres (o for a
+      // left/right pair), not of this wheel's centre, which eq. (5) predicts: in a turn it is
+      // off by yaw rate x (offset of this wheel from that point), +-omega_z track / 2, up to
+      // five times the forward sigma. The distributed filter ignores it; the joint filter
+      // must not, or its position constraint turns the opposite left/right speed errors
+      // into a common heading error of every IMU (0.67 deg heading RMSE on error-free data).
+      // Counted as forward noise at the Wheel-IMU's current yaw rate (its rate without the
+      // spin about its axle c1 = C e_x), so H stays eq. (5)'s.
+      const Mat3 C = w.ekf().state().C_ItoW();
+      const Vec3 wv = C * w.ekf().omega_ib_b();
+      const double yaw_rate = (wv - wv.dot(C.col(0)) * C.col(0)).z();  // without the spin
+      const double e = yaw_rate * (mean_point - w.module().p_inV).norm();
+      jm.R(0, 0) += e * e;
+    }
+    jm.gate = w.velocity_gate();
+  } else {
+    // The mean speed of the wheels is the speed of the mean of their centres (o for a
+    // symmetric pair; the wheel centre itself for one wheel).
+    jm.R = body_->velocity_noise();
+    double speed = mean_speed;
+    mean = n_mean > 0;
+    if (!mean) {
+      speed = body_->ins_speed();
+      jm.R(0, 0) = kNoSpeedVar;
+      mean_point.setZero();
+    }
+    const BodyVelocityModel m = body_->velocity_model(speed, mean_point);
+    jm.H[i] = m.H;
+    jm.dz = m.innovation();
+    jm.gate = body_->velocity_gate();
+  }
+  if (mean)
+    for (int j = 0; j < N; ++j) {
+      if (!sel.in_mean[j]) continue;
+      const WheelIns::SpeedSensitivity ds =
+          static_cast<const WheelIns&>(*subs_[j]).speed_sensitivity();
+      jm.H[j](0, BG) -= ds.dbgx / n_mean;
+      jm.H[j](0, SG) -= ds.dsgx / n_mean;
+    }
+}
+
+bool Navigator::reference_weights(std::array<double, kMaxModules>& k, int& n_ref,
+                                  int& n_tied) const {
+  // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 9) is the
+  // reference, the weights renormalised over them (0 for the others).
+  const int n = subsystem_count();
+  k.fill(0.0);
+  double ksum = 0.0;
+  n_ref = n_tied = 0;
+  for (int i = 0; i < n; ++i) {
+    if (counted(i)) {
+      k[i] = weights_[i];
+      ksum += k[i];
+      ++n_ref;
+    }
+    n_tied += !opt_.faults.enabled || faults_.tied(i);
+  }
+  if (n_ref == 0 || !(ksum > 0.0)) return false;
+  for (int i = 0; i < n; ++i) k[i] /= ksum;
+  return true;
+}
+
+void Navigator::position_measurement(int i, JointMeasurement& jm) const {
+  std::array<double, kMaxModules> k{};
+  int n_ref = 0, n_tied = 0;
+  reference_weights(k, n_ref, n_tied);
+  position_measurement(i, k, jm);
+}
+
+void Navigator::position_measurement(int i, const std::array<double, kMaxModules>& k,
+                                     JointMeasurement& jm) const {
+  // dz_i = r_o^i - sum_j k_j r_o^j (eq. 9, 12) depends on every counted subsystem's state:
+  // (1 - k_i) H_i in block i and -k_j H_j in the others, and, through the level a Wheel-INS
+  // uses in C_v^w (eq. 8), on the Body-INS attitude.
+  const int N = subsystem_count();
+  Vec3 level = Vec3::Zero();
+  const bool shared = level_shared();
+  if (shared) level = body_->vehicle_rpy();
+  Vec3 fused = Vec3::Zero(), own = Vec3::Zero();
+  for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
+  for (int j = 0; j < N; ++j) {
+    const double c = (j == i ? 1.0 : 0.0) - k[j];
+    if (c == 0.0 && k[j] == 0.0) continue;  // neither this module nor in the reference
+    ReferencePointInput in = subs_[j]->reference_point_input();
+    if (shared && in.wheel) {
+      in.vehicle_roll = level.x();
+      in.vehicle_pitch = level.y();
+    }
+    const ReferencePointModel m = reference_point_model(in);
+    jm.H[j] += c * m.H;
+    if (in.wheel) add_level_block(m.H_level, c, jm.H);
+    fused += k[j] * m.r_o;
+    if (j == i) own = m.r_o;
+  }
+  jm.dz = own - fused;
+  const double sd = opt_.fusion.position_std;
+  jm.R = Mat3::Identity() * sd * sd;
+  jm.gate = opt_.fusion.position_gate;
+}
+
+UpdateReport Navigator::fuse_joint(const JointMeasurement& m) {
+  std::array<const H3*, kMaxCentralized> blocks{};
+  for (int j = 0; j < subsystem_count(); ++j) blocks[j] = &m.H[j];
+  std::array<Vec21, kMaxCentralized> dx;
+  const UpdateReport rep = joint_->update(blocks, m.dz, m.R, m.gate, dx);
+  if (rep.accepted)
+    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
+  return rep;
+}
+
+void Navigator::count_velocity_update(int i, const UpdateReport& rep, double t_now) {
+  ++stats_.velocity_updates;
+  if (!rep.accepted) {
+    ++stats_.velocity_rejected;
+    ++faults_.stats(i).velocity_rejected;
+  }
+  stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
+  if (!opt_.faults.enabled || excused_[i] || degraded_ || !faults_.velocity_test(i, rep.test_ratio))
+    return;
+  // The detector fired: isolate the module if the others can go on without it.
+  char what[200];
+  std::snprintf(what, sizeof what,
+                "velocity innovations inconsistent: %d of the last %d test ratios over %.1f",
+                opt_.faults.max_failed, opt_.faults.window, opt_.faults.test_ratio);
+  const int others_ok = faults_.count_ok() - (faults_.counts(i) ? 1 : 0);
+  if (subsystem_count() > 1 && others_ok >= 1 && faults_.tied(i)) {
+    isolate(i, t_now, what);
+  } else if (!rt_[i].detector_fired) {
+    rt_[i].detector_fired = true;
+    faults_.note(i, t_now, what, "no other module to take over: kept (reported once)");
+  }
+}
+
 void Navigator::velocity_updates() {
   const bool handle = opt_.faults.enabled;
   const double t_now = min_time();
   if (handle) fault_housekeeping(t_now);
   // Shared information (Section III): vehicle level from the Body-INS, wheel speed.
-  if (body_ && opt_.fusion.share_level) {
-    int b = 0;
-    while (subs_[b].get() != body_) ++b;
-    if (counted(b)) {
-      const Vec3 rpy = body_->vehicle_rpy();
-      for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
-    }
-  }
+  share_level();
   // Which wheel speeds can be used: not saturated, and (fault handling on) agreeing with
   // the wheel's own INS to within speed_gate sigma of the predicted forward velocity.
   const int n_sub = subsystem_count();
-  std::array<bool, kMaxModules> speed_ok{}, saturated{}, excused{};
+  SpeedSelection& sel = speeds_;
+  sel = SpeedSelection();
+  std::array<bool, kMaxModules> saturated{};
+  excused_.fill(false);
   std::array<WheelVelocityInput, kMaxModules> own;
-  int n_mean = 0;
+  int& n_mean = sel.n_mean;
   double mean_speed = 0.0;
   Vec3 mean_point = Vec3::Zero();
   for (int i = 0; i < n_sub; ++i) {
@@ -243,14 +451,15 @@ void Navigator::velocity_updates() {
     const auto& w = static_cast<const WheelIns&>(*subs_[i]);
     own[i] = w.own_velocity_input();
     if (handle && t_now < rt_[i].saturated_until) saturated[i] = true;
-    speed_ok[i] = !saturated[i];
+    sel.speed_ok[i] = !saturated[i];
     // Saturated, or shortly after: its INS is off for a known reason, not a fault.
-    if (handle && t_now - rt_[i].saturated_until < opt_.faults.retry_after) excused[i] = true;
+    if (handle && t_now - rt_[i].saturated_until < opt_.faults.retry_after) excused_[i] = true;
   }
-  if (handle) check_wheel_speeds(t_now, own, speed_ok);
+  if (handle) check_wheel_speeds(t_now, own, sel.speed_ok);
   for (int i = 0; i < n_sub; ++i) {
     if (!subs_[i]->is_wheel() || !in_use(i)) continue;
-    if (speed_ok[i] && counted(i)) {
+    if (sel.speed_ok[i] && counted(i)) {
+      sel.in_mean[i] = true;
       ++n_mean;
       mean_speed += own[i].measured_speed;
       mean_point += subs_[i]->module().p_inV;
@@ -261,51 +470,40 @@ void Navigator::velocity_updates() {
   {
     bool any_excused = false, any_clean = false;
     for (int i = 0; i < n_sub; ++i)
-      if (subs_[i]->is_wheel() && in_use(i)) (excused[i] ? any_excused : any_clean) = true;
+      if (subs_[i]->is_wheel() && in_use(i)) (excused_[i] ? any_excused : any_clean) = true;
     degraded_ = any_excused && !any_clean;
   }
   if (n_mean == 0)
     for (int i = 0; i < n_sub; ++i)
       if (saturated[i] && counted(i)) {
-        speed_ok[i] = true;
+        sel.speed_ok[i] = sel.in_mean[i] = true;
         ++n_mean;
         mean_speed += own[i].measured_speed;
         mean_point += subs_[i]->module().p_inV;
       }
+  if (joint_) {
+    // Sequential updates, each evaluated at the state the previous one left (the joint
+    // correction moves every IMU's errors); the speed selection stays the epoch's.
+    JointMeasurement& m = joint_scratch_;
+    for (int i = 0; i < n_sub; ++i) {
+      if (!in_use(i)) continue;
+      share_level();
+      velocity_measurement(i, m);
+      count_velocity_update(i, fuse_joint(m), t_now);
+    }
+    return;
+  }
   if (n_mean) {
     mean_speed /= n_mean;
     mean_point /= n_mean;
   }
-  constexpr double kNoSpeedVar = 1e4;  // [m^2/s^2]: a forward row that carries no information
-  auto count = [&](int i, const UpdateReport& rep) {
-    ++stats_.velocity_updates;
-    if (!rep.accepted) {
-      ++stats_.velocity_rejected;
-      ++faults_.stats(i).velocity_rejected;
-    }
-    stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
-    if (!handle || excused[i] || degraded_ || !faults_.velocity_test(i, rep.test_ratio))
-      return;
-    // The detector fired: isolate the module if the others can go on without it.
-    char what[200];
-    std::snprintf(what, sizeof what,
-                  "velocity innovations inconsistent: %d of the last %d test ratios over %.1f",
-                  opt_.faults.max_failed, opt_.faults.window, opt_.faults.test_ratio);
-    const int others_ok = faults_.count_ok() - (faults_.counts(i) ? 1 : 0);
-    if (n_sub > 1 && others_ok >= 1 && faults_.tied(i)) {
-      isolate(i, t_now, what);
-    } else if (!rt_[i].detector_fired) {
-      rt_[i].detector_fired = true;
-      faults_.note(i, t_now, what, "no other module to take over: kept (reported once)");
-    }
-  };
   for (int i = 0; i < n_sub; ++i) {
     if (!in_use(i)) continue;
     if (subs_[i]->is_wheel()) {
       const auto& w = static_cast<const WheelIns&>(*subs_[i]);
       WheelVelocityInput in = own[i];
       Mat3 R = w.velocity_noise();
-      if (speed_ok[i]) {
+      if (sel.speed_ok[i]) {
         if (opt_.fusion.speed == SpeedSharing::kMean && n_mean > 1 && counted(i)) {
           // Its own speed enters the mean with weight 1/n.
           in.measured_speed = mean_speed;
@@ -322,7 +520,7 @@ void Navigator::velocity_updates() {
         R(0, 0) = kNoSpeedVar;
       }
       const WheelVelocityModel m = wheel_velocity_model(in);
-      count(i, fuse(i, m.H, m.innovation(), R, w.velocity_gate()));
+      count_velocity_update(i, fuse(i, m.H, m.innovation(), R, w.velocity_gate()), t_now);
     } else {
       // The mean speed of the wheels is the speed of the mean of their centres (o for a
       // symmetric pair; the wheel centre itself for one wheel).
@@ -334,7 +532,7 @@ void Navigator::velocity_updates() {
         mean_point.setZero();
       }
       const BodyVelocityModel m = body_->velocity_model(speed, mean_point);
-      count(i, fuse(i, m.H, m.innovation(), R, body_->velocity_gate()));
+      count_velocity_update(i, fuse(i, m.H, m.innovation(), R, body_->velocity_gate()), t_now);
     }
   }
 }
@@ -350,31 +548,6 @@ UpdateReport Navigator::fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, 
   return rep;
 }
 
-UpdateReport Navigator::fuse_position_centralized(int i, double gate,
-                                                   const std::array<double, kMaxModules>& k) {
-  // dz_i = r_o^i - sum_j k_j r_o^j depends on every subsystem's state:
-  // H = (1 - k_i) H_i for block i and -k_j H_j for the others.
-  std::array<ReferencePointModel, kMaxCentralized> m;
-  std::array<H3, kMaxCentralized> h;
-  std::array<const H3*, kMaxCentralized> blocks{};
-  Vec3 fused = Vec3::Zero();
-  for (int j = 0; j < subsystem_count(); ++j) {
-    m[j] = reference_point_model(subs_[j]->reference_point_input());
-    fused += k[j] * m[j].r_o;
-  }
-  for (int j = 0; j < subsystem_count(); ++j) {
-    h[j] = ((j == i ? 1.0 : 0.0) - k[j]) * m[j].H;
-    blocks[j] = &h[j];
-  }
-  const double sd = opt_.fusion.position_std;
-  std::array<Vec21, kMaxCentralized> dx;
-  const UpdateReport rep =
-      joint_->update(blocks, m[i].r_o - fused, Mat3::Identity() * sd * sd, gate, dx);
-  if (rep.accepted)
-    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
-  return rep;
-}
-
 Mat21 Navigator::covariance(int i) const {
   return joint_ ? joint_->block(i) : subs_[i]->ekf().covariance();
 }
@@ -384,19 +557,10 @@ void Navigator::position_update() {
   // reference; modules on probation are tied to it without moving it.
   const int n = subsystem_count();
   std::array<double, kMaxModules> k{};
-  double ksum = 0.0;
   int n_ref = 0, n_tied = 0;
-  for (int i = 0; i < n; ++i) {
-    if (counted(i)) {
-      k[i] = weights_[i];
-      ksum += k[i];
-      ++n_ref;
-    }
-    n_tied += !opt_.faults.enabled || faults_.tied(i);
-  }
+  const bool have_ref = reference_weights(k, n_ref, n_tied);
   if (opt_.faults.enabled) check_headings(min_time());
-  if (n_ref == 0 || n_tied < 2 || !(ksum > 0.0)) return;
-  for (int i = 0; i < n; ++i) k[i] /= ksum;
+  if (!have_ref || n_tied < 2) return;
   auto record = [&](const UpdateReport& rep) {
     ++stats_.position_updates;
     if (!rep.accepted) ++stats_.position_rejected;
@@ -408,8 +572,13 @@ void Navigator::position_update() {
   };
   if (joint_) {
     // Sequentially, each re-evaluated at the state the previous one left.
-    for (int i = 0; i < n; ++i)
-      if (receives(i)) record(fuse_position_centralized(i, opt_.fusion.position_gate, k));
+    JointMeasurement& m = joint_scratch_;
+    for (int i = 0; i < n; ++i) {
+      if (!receives(i)) continue;
+      share_level();
+      position_measurement(i, k, m);
+      record(fuse_joint(m));
+    }
     return;
   }
   std::vector<ReferencePointModel>& models = rp_models_;
@@ -571,7 +740,10 @@ void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b)
   rt.saturated_until = raw.t + opt_.faults.saturation_hold;
   if (!substituted) return;
   // The axle rate the wheel must have at that speed replaces the clipped reading (the
-  // estimated bias is added back, as the filter removes it).
+  // estimated bias is added back, as the filter removes it). The edited sample is what
+  // propagate() gets, so the speed window (raw rates, compensated with the current
+  // estimates) holds the substituted rate too. (Putting the scale factor back as well,
+  // (1 + s_g,x), made the saturation test worse: 3.3 % drift instead of 1.2 %.)
   // The reading says the wheel turns at least at full scale.
   const auto& w = static_cast<const WheelIns&>(*subs_[index]);
   const double floor = subs_[index]->module().gyro_range * subs_[index]->module().wheel_radius;

@@ -81,6 +81,14 @@ struct NavigatorStats {
   double max_covariance_asymmetry = 0.0;
 };
 
+/// One measurement of the centralized filter: dz = sum_j H[j] dx_j + e, e ~ N(0, R).
+struct JointMeasurement {
+  std::array<H3, kMaxCentralized> H;
+  Vec3 dz = Vec3::Zero();
+  Mat3 R = Mat3::Identity();
+  double gate = 0.0;
+};
+
 class Navigator {
  public:
   static constexpr int kMaxModules = 16;
@@ -102,6 +110,14 @@ class Navigator {
   const NavigatorStats& stats() const { return stats_; }
   int subsystem_count() const { return static_cast<int>(subs_.size()); }
   const Subsystem& subsystem(int i) const { return *subs_.at(i); }
+  Subsystem& subsystem(int i) { return *subs_.at(i); }
+  /// The centralized filter's measurements of subsystem i at the current state (also
+  /// usable without a joint covariance, for checking them): the velocity + NHC update
+  /// (eq. 5/6) and the position constraint (eq. 12), H with a block for every IMU.
+  /// With fault handling, only the modules that count enter the mean wheel speed and the
+  /// reference (the velocity measurement uses the speed selection of the last update epoch).
+  void velocity_measurement(int i, JointMeasurement& m) const;
+  void position_measurement(int i, JointMeasurement& m) const;
   /// The fused vehicle solution now.
   TrajectoryRecord vehicle_record() const;
   /// Health, counters and the report of detected faults.
@@ -111,13 +127,36 @@ class Navigator {
 
  private:
   void start_navigation(double t0);
+  /// Forward variance of a velocity row that carries no speed [m^2/s^2].
+  static constexpr double kNoSpeedVar = 1e4;
+  /// The wheel speeds an update epoch uses: speed_ok (in use, not saturated, agreeing with
+  /// its own INS) and in_mean (also counted: the wheels whose speeds make the mean).
+  struct SpeedSelection {
+    std::array<bool, kMaxModules> speed_ok{}, in_mean{};
+    int n_mean = 0;
+  };
+  /// Velocity updates of every module in use; in the centralized filter H also carries the
+  /// other IMUs' blocks (velocity_measurement()).
   void velocity_updates();
+  void count_velocity_update(int i, const UpdateReport& rep, double t_now);
+  /// The Body-INS level is shared: sharing on and the Body-INS counted.
+  bool level_shared() const;
+  /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
+  void share_level();
+  /// The reference weights k (eq. 9) renormalised over the counted modules (0 for the
+  /// others); false when no module counts.
+  bool reference_weights(std::array<double, kMaxModules>& k, int& n_ref, int& n_tied) const;
+  void position_measurement(int i, const std::array<double, kMaxModules>& k,
+                            JointMeasurement& m) const;
+  /// Adds, to the Body-INS block of a joint H, the dependence of a Wheel-INS measurement on
+  /// the shared level: H_level * d(roll, pitch)/d(phi_body), scaled by `c`.
+  void add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
+                       std::array<H3, kMaxCentralized>& h) const;
+  /// Fuses a joint measurement into the joint covariance and feeds every subsystem back.
+  UpdateReport fuse_joint(const JointMeasurement& m);
   void position_update();
   /// Fuses dz = H dx_i + e into subsystem i (distributed) or the joint state (centralized).
   UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
-  /// Position constraint of subsystem i in the centralized filter (depends on every state).
-  UpdateReport fuse_position_centralized(int i, double gate,
-                                         const std::array<double, kMaxModules>& k);
   Mat21 covariance(int i) const;
   TrajectoryRecord subsystem_record(int i) const;
   /// Weighted mean of the subsystems in `use` (the paper's output, eq. 9).
@@ -164,12 +203,16 @@ class Navigator {
   std::vector<std::unique_ptr<Subsystem>> subs_;
   std::vector<WheelIns*> wheels_;
   BodyIns* body_ = nullptr;
+  int body_index_ = -1;  ///< position of the Body-INS in subs_
   std::vector<double> weights_;
   std::vector<StaticAccumulator> static_;
   std::vector<ReferencePointModel> rp_models_;  ///< scratch of position_update(), sized once
   std::unique_ptr<JointCovariance> joint_;
+  JointMeasurement joint_scratch_;  ///< of the centralized updates
+  SpeedSelection speeds_;           ///< the wheel speeds usable at the last update epoch
   FaultMonitor faults_;
   bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
+  std::array<bool, kMaxModules> excused_{};  ///< saturated or recovering this epoch
   std::vector<Runtime> rt_;
   bool navigating_ = false;
   double last_output_t_ = -1e300;
