@@ -1,5 +1,7 @@
 #include "wheelins/sim/faults.hpp"
 
+#include "wheelins/io/text_util.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -19,18 +21,7 @@ constexpr FaultKind kKinds[] = {FaultKind::kDropout, FaultKind::kGyroBiasJump, F
 const char* const kAxes = "xyz";
 
 /// Shortest decimal text that reads back as exactly x (so specs and YAML round-trip).
-std::string num(double x) {
-  char buf[40];
-  // Enough digits for the integer part, so 40 prints as "40", not "4e+01".
-  const int int_digits = std::abs(x) >= 1.0 && std::abs(x) < 1e17
-                             ? static_cast<int>(std::floor(std::log10(std::abs(x)))) + 1
-                             : 1;
-  for (int p = std::max(1, int_digits); p <= 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*g", p, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
+std::string num(double x) { return io_detail::format_double(x); }
 
 /// A strict number: the whole text, finite.
 std::optional<double> parse_number(const std::string& s) {
