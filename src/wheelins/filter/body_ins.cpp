@@ -26,12 +26,7 @@ void BodyIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
   s.q_ItoW = Quat(C).normalized();
   s.p_IinW = fix.p_OinW + C * C_BtoV_.transpose() * module_.p_inV;
   s.v_IinW = fix.v_OinW;
-  InitialUncertainty init;
-  init.position = fix.position_std;
-  init.velocity = fix.velocity_std;
-  init.roll_pitch = fix.level_std;
-  init.heading = fix.heading_std;
-  ekf_.initialize(s, ekf_.errors(), module_.noise, init, mech_);
+  ekf_.initialize(s, ekf_.errors(), module_.noise, fix.uncertainty(), mech_);
 }
 
 Eigen::RowVector3d BodyIns::heading_sensitivity() const {

@@ -21,6 +21,15 @@ struct VehicleFix {
   double velocity_std = 0.3;   ///< [m/s]; also covers the lever-arm velocities left out
   double level_std = 3.0 * kDeg;  ///< roll/pitch from the averaged specific force in motion
   double heading_std = 1.0 * kDeg;
+  /// The restart's initial uncertainty.
+  InitialUncertainty uncertainty() const {
+    InitialUncertainty u;
+    u.position = position_std;
+    u.velocity = velocity_std;
+    u.roll_pitch = level_std;
+    u.heading = heading_std;
+    return u;
+  }
 };
 
 /// Mean specific force over a stretch of motion, expressed in the b-frame at its end:

@@ -55,12 +55,7 @@ void WheelIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
   const Mat3 C = s.C_ItoW();
   s.p_IinW = fix.p_OinW + rot_z(fix.heading) * module_.p_inV - C * module_.lever_arm_inB;
   s.v_IinW = fix.v_OinW;
-  InitialUncertainty init;
-  init.position = fix.position_std;
-  init.velocity = fix.velocity_std;
-  init.roll_pitch = fix.level_std;
-  init.heading = fix.heading_std;
-  begin(s, ekf_.errors(), init);
+  begin(s, ekf_.errors(), fix.uncertainty());
 }
 
 double WheelIns::yaw_rate() const {
