@@ -40,6 +40,7 @@ struct RunArgs {
   bool quiet = false;
   double duration = 0.0;
   double output_interval = -1.0;
+  double covariance_interval = -1.0;
 };
 
 int run(const RunArgs& a) {
@@ -62,6 +63,7 @@ int run(const RunArgs& a) {
   if (a.duration > 0) cfg.max_duration = a.duration;
   if (a.no_faults) cfg.nav.faults.enabled = false;
   if (a.output_interval >= 0) cfg.nav.output_interval = a.output_interval;
+  if (a.covariance_interval >= 0) cfg.nav.covariance_interval = a.covariance_interval;
 
   RunRequest req = make_run_request(cfg, stderr_sink());
   req.progress = !a.quiet;
@@ -144,6 +146,10 @@ const bool registered = cli::register_command(
                    "fault isolation)");
       sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
       sub.add_option("--output-interval", a->output_interval, "Output interval [s]; 0 = every epoch");
+      sub.add_option("--covariance-interval", a->covariance_interval,
+                     "Covariance time update every this many seconds (F integrated in between); "
+                     "0 = every IMU epoch")
+          ->check(CLI::Range(0.0, 0.5));
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line and no option listing");
       return [a]() { return run(*a); };

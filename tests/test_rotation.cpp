@@ -78,6 +78,21 @@ TEST(Earth, LocalFrameRoundTrip) {
   EXPECT_NEAR(d.y(), 0.0, 1e-6);
 }
 
+TEST(Earth, GeodeticFromEcefInvertsEcefFromGeodetic) {
+  // The closed form (Bowring + one refinement) against the forward transformation, from
+  // the equator to the poles and from -1 km to 100 km.
+  for (double lat_deg = -90.0; lat_deg <= 90.0; lat_deg += 0.7)
+    for (double h : {-1000.0, -12.3, 0.0, 20.0, 8848.0, 100000.0}) {
+      const earth::Geodetic g{lat_deg * kDeg, (lat_deg * 3.1 - 40.0) * kDeg, h};
+      const earth::Geodetic back = earth::geodetic_from_ecef(earth::ecef_from_geodetic(g));
+      ASSERT_NEAR(back.lat, g.lat, 1e-13) << lat_deg << " deg, " << h << " m";
+      ASSERT_NEAR(back.h, g.h, 1e-6) << lat_deg << " deg, " << h << " m";
+      if (std::abs(lat_deg) < 89.9) {
+        ASSERT_NEAR(wrap_pi(back.lon - g.lon), 0.0, 1e-14);
+      }
+    }
+}
+
 TEST(Earth, NormalGravity) {
   EXPECT_NEAR(earth::normal_gravity(0.0, 0.0), 9.7803, 1e-3);
   EXPECT_NEAR(earth::normal_gravity(kPi / 2, 0.0), 9.8322, 1e-3);

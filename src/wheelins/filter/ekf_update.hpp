@@ -35,8 +35,10 @@ UpdateReport ekf_update(Mat21& P, Vec21& dx, const Eigen::Matrix<double, M, kSta
   static_assert(M >= 1 && M <= 6);
   using MatM = Eigen::Matrix<double, M, M>;
   using MatNM = Eigen::Matrix<double, kStateDim, M>;
-  const MatNM PHt = P * H.transpose();
-  const MatM S = H * PHt + R;
+  // Coefficient-based (lazy) products: at these fixed sizes they beat Eigen's blocked GEMM,
+  // which packs its operands first.
+  const MatNM PHt = P.lazyProduct(H.transpose());
+  const MatM S = H.lazyProduct(PHt) + R;
   const Eigen::LLT<MatM> llt(S);
   UpdateReport rep;
   rep.dim = M;
@@ -50,10 +52,15 @@ UpdateReport ekf_update(Mat21& P, Vec21& dx, const Eigen::Matrix<double, M, kSta
   if (gate > 0.0 && rep.test_ratio > gate) return rep;
 
   const MatNM K = llt.solve(PHt.transpose()).transpose();
-  dx += K * (dz - H * dx);
-  Mat21 IKH = -K * H;
-  IKH.diagonal().array() += 1.0;
-  P = IKH * P * IKH.transpose() + K * R * K.transpose();
+  dx += K * (dz - H.lazyProduct(dx));
+  // Joseph form (I - KH) P (I - KH)^T + K R K^T, multiplied out so that no n x n x n
+  // product is formed: P - K (PH^T)^T - (PH^T) K^T + K S K^T (S = HPH^T + R). The
+  // identity holds for any K, so the form keeps Joseph's tolerance of a K that is not
+  // exactly optimal; O(n^2 M) instead of O(n^3).
+  const MatNM KS = K.lazyProduct(S);
+  P -= K.lazyProduct(PHt.transpose());
+  P -= PHt.lazyProduct(K.transpose());
+  P += KS.lazyProduct(K.transpose());
   P = 0.5 * (P + P.transpose()).eval();
   rep.accepted = true;
   return rep;

@@ -23,11 +23,11 @@ Mat21 error_dynamics(const Mat3& C_BtoW, const Vec3& omega_b, const Vec3& f_b,
 /// The non-zero blocks of F (eq. 2) for one epoch; Phi = I + F dt is applied through
 /// them (apply_transition), never as a dense 21 x 21 product.
 struct ErrorDynamics {
-  Mat3 W;          ///< [w_ie x]
-  Mat3 Ff;         ///< [f^w x]
-  Mat3 C;          ///< C_b^w
-  Mat3 Cf;         ///< C diag(f)
-  Mat3 Cw;         ///< C diag(omega)
+  Mat3 W = Mat3::Zero();   ///< [w_ie x]
+  Mat3 Ff = Mat3::Zero();  ///< [f^w x]
+  Mat3 C = Mat3::Zero();   ///< C_b^w
+  Mat3 Cf = Mat3::Zero();  ///< C diag(f)
+  Mat3 Cw = Mat3::Zero();  ///< C diag(omega)
   double decay_bg = 0, decay_ba = 0, decay_sg = 0, decay_sa = 0;  ///< 1 / tau
 };
 ErrorDynamics error_dynamics_blocks(const Mat3& C_BtoW, const Vec3& omega_b, const Vec3& f_b,

@@ -10,6 +10,7 @@ void StrapdownEkf::initialize(const NavState& state, const ImuErrors& errors,
   noise_ = noise;
   mech_ = mech;
   have_last_ = false;
+  clear_pending();
   P_.setZero();
   P_.block<3, 3>(P, P).diagonal().setConstant(init.position * init.position);
   P_.block<3, 3>(V, V).diagonal().setConstant(init.velocity * init.velocity);
@@ -28,8 +29,46 @@ void StrapdownEkf::propagate_nominal(const ImuSample& raw) {
   last_ = cur;
   last_raw_ = raw;
   have_last_ = true;
-  dyn_ = error_dynamics_blocks(state_.C_ItoW(), cur.dtheta / cur.dt, cur.dvel / cur.dt,
-                              mech_.omega_ie_inW, noise_);
+  const ErrorDynamics d = error_dynamics_blocks(state_.C_ItoW(), cur.dtheta / cur.dt,
+                                                cur.dvel / cur.dt, mech_.omega_ie_inW, noise_);
+  if (pending_dt_ == 0.0) {
+    pending_.W = d.W;
+    pending_.decay_bg = d.decay_bg;
+    pending_.decay_ba = d.decay_ba;
+    pending_.decay_sg = d.decay_sg;
+    pending_.decay_sa = d.decay_sa;
+  }
+  pending_.Ff += cur.dt * d.Ff;
+  pending_.C += cur.dt * d.C;
+  pending_.Cf += cur.dt * d.Cf;
+  pending_.Cw += cur.dt * d.Cw;
+  pending_dt_ += cur.dt;
+}
+
+ErrorDynamics StrapdownEkf::pending_dynamics() const {
+  ErrorDynamics d = pending_;
+  if (pending_dt_ > 0.0) {
+    const double k = 1.0 / pending_dt_;
+    d.Ff *= k;
+    d.C *= k;
+    d.Cf *= k;
+    d.Cw *= k;
+  }
+  return d;
+}
+
+void StrapdownEkf::clear_pending() {
+  pending_.Ff.setZero();
+  pending_.C.setZero();
+  pending_.Cf.setZero();
+  pending_.Cw.setZero();
+  pending_dt_ = 0.0;
+}
+
+void StrapdownEkf::flush_covariance() {
+  if (!own_covariance_ || pending_dt_ <= 0.0) return;
+  propagate_covariance(P_, pending_dynamics(), noise_, pending_dt_);
+  clear_pending();
 }
 
 void StrapdownEkf::feedback(const Vec21& dx) {

@@ -25,19 +25,34 @@ class StrapdownEkf {
   void initialize(const NavState& state, const ImuErrors& errors, const ProcessNoise& noise,
                   const InitialUncertainty& init, const MechanizationOptions& mech);
 
-  /// One IMU epoch: compensate, mechanize, propagate the covariance. `raw` is in the
-  /// IMU b-frame (mounting already applied), as increments.
+  /// One IMU epoch: compensate, mechanize, and accumulate F; the covariance is
+  /// propagated once `covariance_interval` has passed (see set_covariance_interval).
+  /// `raw` is in the IMU b-frame (mounting already applied), as increments.
   void propagate(const ImuSample& raw) {
     propagate_nominal(raw);
-    if (own_covariance_) propagate_covariance(P_, dyn_, noise_, last_.dt);
+    if (own_covariance_ && covariance_due()) flush_covariance();
   }
-  /// A centralized filter keeps the covariance: propagate() then skips this one's P.
+  /// A centralized filter keeps the covariance: propagate() then leaves this one's P alone
+  /// and the owner takes the accumulated dynamics (pending_dynamics, clear_pending).
   void set_external_covariance(bool external) { own_covariance_ = !external; }
-  /// The nominal part only (compensation, mechanization, F of this epoch); a
-  /// centralized filter propagates the joint covariance itself.
+  /// The nominal part only (compensation, mechanization, F of this epoch accumulated).
   void propagate_nominal(const ImuSample& raw);
-  /// The blocks of F of the last epoch (at the propagated state).
-  const ErrorDynamics& last_dynamics() const { return dyn_; }
+
+  /// Covariance time update at a lower rate than the mechanization: the blocks of F are
+  /// integrated over the epochs of `interval` seconds and P is propagated once with
+  /// Phi = I + (integral of F dt) (eq. 2 discretized over the interval; exact to first
+  /// order in the interval, and C_b^w of a spinning wheel is integrated, not sampled).
+  /// 0 = every epoch. Every measurement update first propagates P to the current epoch.
+  void set_covariance_interval(double interval) { covariance_interval_ = interval; }
+  double covariance_interval() const { return covariance_interval_; }
+  /// The accumulated dynamics are due for a covariance propagation.
+  bool covariance_due() const { return pending_dt_ + 1e-9 >= covariance_interval_; }
+  /// Propagates the own P over the accumulated epochs (no-op if none).
+  void flush_covariance();
+  /// The accumulated F blocks averaged over pending_dt() (for an external covariance).
+  ErrorDynamics pending_dynamics() const;
+  double pending_dt() const { return pending_dt_; }
+  void clear_pending();
   const ProcessNoise& noise() const { return noise_; }
 
   /// Fuses a measurement (dz = z_hat - z_meas = H dx + e) and feeds the error back.
@@ -45,6 +60,7 @@ class StrapdownEkf {
   UpdateReport update(const Eigen::Matrix<double, M, kStateDim>& H,
                       const Eigen::Matrix<double, M, 1>& dz, const Eigen::Matrix<double, M, M>& R,
                       double gate = 0.0) {
+    flush_covariance();
     Vec21 dx = Vec21::Zero();
     const UpdateReport rep = ekf_update<M>(P_, dx, H, dz, R, gate);
     if (rep.accepted) feedback(dx);
@@ -53,8 +69,13 @@ class StrapdownEkf {
 
   const NavState& state() const { return state_; }
   const ImuErrors& errors() const { return errors_; }
+  /// P as of the last covariance propagation (at most covariance_interval() old; the
+  /// non-const accessor propagates it to the current epoch first).
   const Mat21& covariance() const { return P_; }
-  Mat21& covariance() { return P_; }
+  Mat21& covariance() {
+    flush_covariance();
+    return P_;
+  }
   /// The last sample compensated with the current error estimates, as rates [rad/s],
   /// [m/s^2] (after a feedback, the corrected estimates apply: measurement models evaluated
   /// between two epochs, e.g. a centralized filter's sequential updates, stay consistent).
@@ -73,7 +94,9 @@ class StrapdownEkf {
   NavState state_;
   ImuErrors errors_;
   Mat21 P_ = Mat21::Zero();
-  ErrorDynamics dyn_;
+  ErrorDynamics pending_;      ///< sum of F's blocks * dt since the last propagation
+  double pending_dt_ = 0.0;
+  double covariance_interval_ = 0.0;
   ProcessNoise noise_;
   MechanizationOptions mech_;
   ImuSample last_;

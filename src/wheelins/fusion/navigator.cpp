@@ -34,6 +34,10 @@ std::string NavigatorOptions::describe() const {
                                                                        : "classic two-sample")
     << "\n"
     << "earth rotation:             " << (earth_rotation ? "compensated" : "ignored") << "\n"
+    << "covariance time update:     "
+    << (covariance_interval > 0 ? "every " + std::to_string(covariance_interval) + " s"
+                                : std::string("every epoch"))
+    << "\n"
     << faults.describe()
     << "output interval:            "
     << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
@@ -70,6 +74,7 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
       body_index_ = static_cast<int>(subs_.size());
       subs_.push_back(std::move(b));
     }
+    subs_.back()->ekf().set_covariance_interval(opt_.covariance_interval);
   }
   if (wheels_.empty())
     throw InputError("no Wheel-IMU among the selected modules: at least one IMU must be on a "
@@ -145,7 +150,7 @@ void Navigator::process(int index, const ImuSample& raw) {
     if (s.is_wheel() && s.module().gyro_range > 0.0) handle_saturation(index, raw, b);
   }
   s.propagate(b);
-  if (joint_) joint_->propagate(index, s.ekf().last_dynamics(), s.ekf().noise(), b.dt);
+  if (joint_ && s.ekf().covariance_due()) propagate_joint(index);
 
   // Updates when every subsystem in use has reached the scheduled time.
   const double t_all = min_time();
@@ -173,16 +178,7 @@ void Navigator::process(int index, const ImuSample& raw) {
   // (raw.t > last: when the driving module changes, the new one may share the epoch.)
   if (raw.t + 1e-9 >= next_output_t_ && raw.t > last_output_t_) {
     last_output_t_ = raw.t;
-    TrajectoryRecord v = vehicle_record();
-    v.t = raw.t;  // the epoch of the module driving the output
-    sink_(0, v);
-    if (subs_.size() > 1)
-      for (int i = 0; i < subsystem_count(); ++i)
-        // A module whose data have stopped (not yet declared out) has nothing new.
-        if (in_use(i) && subs_[i]->time() > rt_[i].last_record_t) {
-          rt_[i].last_record_t = subs_[i]->time();
-          sink_(i + 1, subsystem_record(i));
-        }
+    write_records(raw.t);
     ++stats_.records;
     if (opt_.output_interval > 0)
       while (next_output_t_ <= raw.t + 1e-9) next_output_t_ += opt_.output_interval;
@@ -396,6 +392,20 @@ void Navigator::position_measurement(int i, const std::array<double, kMaxModules
   jm.gate = opt_.fusion.position_gate;
 }
 
+void Navigator::propagate_joint(int i) {
+  StrapdownEkf& ekf = subs_[i]->ekf();
+  if (ekf.pending_dt() <= 0.0) return;
+  joint_->propagate(i, ekf.pending_dynamics(), ekf.noise(), ekf.pending_dt());
+  ekf.clear_pending();
+}
+
+void Navigator::flush_covariances() {
+  for (int i = 0; i < subsystem_count(); ++i) {
+    if (joint_) propagate_joint(i);
+    else subs_[i]->ekf().flush_covariance();
+  }
+}
+
 UpdateReport Navigator::fuse_joint(const JointMeasurement& m) {
   std::array<const H3*, kMaxCentralized> blocks{};
   for (int j = 0; j < subsystem_count(); ++j) blocks[j] = &m.H[j];
@@ -430,6 +440,7 @@ void Navigator::count_velocity_update(int i, const UpdateReport& rep, double t_n
 }
 
 void Navigator::velocity_updates() {
+  flush_covariances();  // every P at this epoch before any measurement uses it
   const bool handle = opt_.faults.enabled;
   const double t_now = min_time();
   if (handle) fault_housekeeping(t_now);
@@ -553,6 +564,7 @@ Mat21 Navigator::covariance(int i) const {
 }
 
 void Navigator::position_update() {
+  flush_covariances();
   // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 9) is the
   // reference; modules on probation are tied to it without moving it.
   const int n = subsystem_count();
@@ -616,7 +628,8 @@ TrajectoryRecord Navigator::subsystem_record(int i) const {
     if (body_ && opt_.fusion.share_level) r.rpy.head<2>() = body_->vehicle_rpy().head<2>();
   }
   r.rpy_std.z() = std::sqrt(std::max(0.0, var_psi));
-  r.p_std = (m.H * P * m.H.transpose()).diagonal().cwiseSqrt();
+  // diag(H P H^T) without the full product: row k of H P dotted with row k of H.
+  r.p_std = (m.H.lazyProduct(P)).cwiseProduct(m.H).rowwise().sum().cwiseSqrt();
   r.v_std = P.block<3, 3>(V, V).diagonal().cwiseSqrt();
   const ImuErrors& e = ekf.errors();
   r.bg = e.bg;
@@ -630,26 +643,59 @@ TrajectoryRecord Navigator::subsystem_record(int i) const {
   return r;
 }
 
-TrajectoryRecord Navigator::vehicle_record() const {
+std::array<bool, Navigator::kMaxModules> Navigator::vehicle_modules() const {
   std::array<bool, kMaxModules> use{};
   bool any = false;
   for (int i = 0; i < subsystem_count(); ++i) any |= use[i] = counted(i);
   if (!any)
     for (int i = 0; i < subsystem_count(); ++i) use[i] = in_use(i);
-  return fused_record(use);
+  return use;
+}
+
+int Navigator::first_used(const std::array<bool, kMaxModules>& use) {
+  for (int i = 0; i < kMaxModules; ++i)
+    if (use[i]) return i;
+  return 0;
+}
+
+TrajectoryRecord Navigator::vehicle_record() const { return fused_record(vehicle_modules()); }
+
+void Navigator::write_records(double t) {
+  const std::array<bool, kMaxModules> use = vehicle_modules();
+  const int first = first_used(use);
+  const int n = subsystem_count();
+  for (int i = 0; i < n; ++i)
+    if (use[i] || i == first || (n > 1 && in_use(i))) out_recs_[i] = subsystem_record(i);
+  TrajectoryRecord v = fuse_records(use, out_recs_);
+  v.t = t;  // the epoch of the module driving the output
+  sink_(0, v);
+  if (n > 1)
+    for (int i = 0; i < n; ++i)
+      // A module whose data have stopped (not yet declared out) has nothing new.
+      if (in_use(i) && subs_[i]->time() > rt_[i].last_record_t) {
+        rt_[i].last_record_t = subs_[i]->time();
+        sink_(i + 1, out_recs_[i]);
+      }
 }
 
 TrajectoryRecord Navigator::fused_record(const std::array<bool, kMaxModules>& use) const {
-  int first = -1, n_use = 0;
+  Records recs;
+  const int first = first_used(use);
+  for (int i = 0; i < subsystem_count(); ++i)
+    if (use[i] || i == first) recs[i] = subsystem_record(i);
+  return fuse_records(use, recs);
+}
+
+TrajectoryRecord Navigator::fuse_records(const std::array<bool, kMaxModules>& use,
+                                         const Records& recs) const {
+  int n_use = 0;
   double ksum = 0.0;
   for (int i = 0; i < subsystem_count(); ++i)
     if (use[i]) {
-      if (first < 0) first = i;
       ++n_use;
       ksum += weights_[i];
     }
-  if (first < 0) first = 0;
-  TrajectoryRecord r = subsystem_record(first);
+  TrajectoryRecord r = recs[first_used(use)];
   if (subs_.size() == 1 || n_use <= 1) return r;
   // Output as in the paper: the fused reference point and the mean heading. The 1-sigma
   // of a weighted mean is bounded by the weighted mean of the sigmas whatever the
@@ -660,7 +706,7 @@ TrajectoryRecord Navigator::fused_record(const std::array<bool, kMaxModules>& us
   for (int i = 0; i < subsystem_count(); ++i) {
     if (!use[i]) continue;
     if (subs_[i].get() == body_) body_index = i;
-    const TrajectoryRecord ri = subsystem_record(i);
+    const TrajectoryRecord& ri = recs[i];
     const double k = weights_[i] / ksum;
     p += k * ri.p_inN;
     v += k * ri.v_inN;

@@ -54,6 +54,10 @@ struct NavigatorOptions {
   FaultOptions faults;
   /// Output interval [s]; 0 = every epoch of the first module.
   double output_interval = 0.0;
+  /// Covariance time update every this many seconds, F integrated over the epochs in
+  /// between (StrapdownEkf::set_covariance_interval); 0 = every IMU epoch. Measurement
+  /// updates always see P propagated to their epoch.
+  double covariance_interval = 0.0;
   /// The options in human units (OpenVINS style), one per line.
   std::string describe() const;
 };
@@ -154,6 +158,10 @@ class Navigator {
                        std::array<H3, kMaxCentralized>& h) const;
   /// Fuses a joint measurement into the joint covariance and feeds every subsystem back.
   UpdateReport fuse_joint(const JointMeasurement& m);
+  /// Moves subsystem i's accumulated dynamics into the joint covariance.
+  void propagate_joint(int i);
+  /// Every covariance (own or joint) propagated to the current epoch.
+  void flush_covariances();
   void position_update();
   /// Fuses dz = H dx_i + e into subsystem i (distributed) or the joint state (centralized).
   UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
@@ -161,6 +169,17 @@ class Navigator {
   TrajectoryRecord subsystem_record(int i) const;
   /// Weighted mean of the subsystems in `use` (the paper's output, eq. 9).
   TrajectoryRecord fused_record(const std::array<bool, kMaxModules>& use) const;
+  using Records = std::array<TrajectoryRecord, kMaxModules>;
+  /// The same from records already made (recs[i] valid where use[i], and recs[first]).
+  TrajectoryRecord fuse_records(const std::array<bool, kMaxModules>& use,
+                                const Records& recs) const;
+  /// Which modules the vehicle solution is made of now.
+  std::array<bool, kMaxModules> vehicle_modules() const;
+  /// The first module in `use` (0 if none).
+  static int first_used(const std::array<bool, kMaxModules>& use);
+  /// Output of one epoch: the vehicle record and each module's, each made once.
+  void write_records(double t);
+  Records out_recs_{};  ///< scratch of write_records (no allocation per epoch)
   double min_time() const;
 
   // Fault handling (fault_monitor.hpp).

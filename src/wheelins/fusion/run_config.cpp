@@ -62,7 +62,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     y.check_keys(f, "filter",
                  {"mechanization", "earth_rotation", "velocity_update_hz", "speed_window_s",
                   "wheel_velocity_std_m_s", "body_velocity_std_m_s", "velocity_gate",
-                  "initial_std"});
+                  "initial_std", "covariance_interval_s"});
     if (auto v = y.get(f, "mechanization"); v.IsDefined())
       c.nav.mechanization = y.choice<MechanizationOptions::Method>(
           v, "filter.mechanization",
@@ -71,6 +71,11 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     if (auto v = y.get(f, "earth_rotation"); v.IsDefined())
       c.earth_rotation = y.choice<std::string>(v, "filter.earth_rotation",
                                                {{"auto", "auto"}, {"true", "true"}, {"false", "false"}});
+    if (auto v = y.get(f, "covariance_interval_s"); v.IsDefined()) {
+      c.nav.covariance_interval = y.number(v, "filter.covariance_interval_s");
+      if (c.nav.covariance_interval < 0 || c.nav.covariance_interval > 0.5)
+        y.fail("filter.covariance_interval_s", "must be in [0, 0.5] s", &v);
+    }
     if (auto v = y.get(f, "velocity_update_hz"); v.IsDefined()) {
       const double hz = y.number(v, "filter.velocity_update_hz");
       y.positive(hz, "filter.velocity_update_hz", v);
