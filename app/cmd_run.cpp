@@ -92,7 +92,7 @@ int run(const RunArgs& a) {
               nav_s, static_cast<unsigned long long>(st.epochs), res.wall_seconds,
               1e6 * res.wall_seconds / std::max<double>(1.0, static_cast<double>(st.epochs)),
               nav_s / std::max(1e-9, res.wall_seconds));
-  std::printf("navigator incl. output formatting, excl. input reading: %.2f us per epoch\n",
+  std::printf("navigator incl. output records, excl. input reading and file writing (second thread): %.2f us per epoch\n",
               1e6 * res.filter_seconds / std::max<double>(1.0, static_cast<double>(st.epochs)));
   std::printf("velocity updates: %llu (%llu rejected, max test ratio %.2f)\n",
               static_cast<unsigned long long>(st.velocity_updates),

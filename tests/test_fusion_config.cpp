@@ -61,6 +61,7 @@ chips: [C1, C2, C4]
 output: {dir: out/t, formats: [csv], interval_s: 0.1, overwrite: true}
 filter:
   velocity_update_hz: 4
+  covariance_interval_s: 0.02
   wheel_velocity_std_m_s: [0.05, 0.03, 0.03]
   initial_std: {heading_deg: 0.5}
 fusion: {speed: own, position_update_hz: 2, position_std_m: 0.3, centralized: true}
@@ -76,6 +77,7 @@ faults: {heading_gate_deg: 8, window: 30, max_failed: 20, probation_s: 5}
   EXPECT_TRUE(c.overwrite);
   EXPECT_DOUBLE_EQ(c.nav.output_interval, 0.1);
   EXPECT_DOUBLE_EQ(c.nav.wheel.velocity_update_interval, 0.25);
+  EXPECT_DOUBLE_EQ(c.nav.covariance_interval, 0.02);
   EXPECT_DOUBLE_EQ(c.nav.wheel.velocity_std.x(), 0.05);
   EXPECT_NEAR(c.nav.wheel.init.heading, 0.5 * kDeg, 1e-15);
   EXPECT_EQ(c.nav.fusion.speed, SpeedSharing::kOwn);
@@ -103,6 +105,8 @@ TEST(FusionRunConfig, BadValuesNameTheKeyAndLine) {
             std::string::npos) << e;
   e = load("dataset: m.yaml\nfilter:\n  wheel_velocity_std_m_s: [0.03, -1, 0.02]\n");
   EXPECT_NE(e.find("filter.wheel_velocity_std_m_s: must be > 0"), std::string::npos) << e;
+  e = load("dataset: m.yaml\nfilter:\n  covariance_interval_s: 2\n");
+  EXPECT_NE(e.find("filter.covariance_interval_s: must be in [0, 0.5] s"), std::string::npos) << e;
   e = load("dataset: m.yaml\nfusion: {speed: fastest}\n");
   EXPECT_NE(e.find("fusion.speed: expected mean or own"), std::string::npos) << e;
   e = load("dataset: m.yaml\nfaults:\n  window: 10\n  max_failed: 12\n");

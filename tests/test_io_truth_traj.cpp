@@ -3,12 +3,15 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <charconv>
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/binary.hpp"
 #include "wheelins/io/trajectory.hpp"
 #include "wheelins/io/truth.hpp"
@@ -516,4 +519,40 @@ TEST(IoTraj, BadInputNamesFileAndLine) {
   w->write(sample_traj_record(1));
   expect_input_error([&] { w->write(sample_traj_record(0)); },
                      {"order.csv", "record 1", "does not increase"});
+}
+
+TEST(IoText, SignificantDigitsMatchToChars) {
+  // append_double(v, p) takes a fast path for fixed notation; it must write what
+  // std::to_chars(general, p) writes (the last digit may differ only on a near-tie).
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mant(1.0, 10.0);
+  std::uniform_int_distribution<int> expo(-7, 16);
+  int mismatches = 0, n = 0;
+  for (int p : {1, 3, 6, 9, 12, 15})
+    for (int i = 0; i < 40000; ++i, ++n) {
+      double v = mant(rng) * std::pow(10.0, expo(rng));
+      if (i % 2) v = -v;
+      if (i % 97 == 0) v = std::round(v);          // integers, trailing zeros
+      if (i % 89 == 0) v = 9.999999999999 * std::pow(10.0, expo(rng));  // carries
+      std::string got;
+      append_double(got, v, p);
+      char buf[64];
+      const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, p);
+      const std::string want(buf, res.ptr);
+      if (got != want) {
+        ++mismatches;
+        const double g = std::stod(got), w = std::stod(want);
+        ASSERT_LE(std::abs(g - w), 1.5 * std::pow(10.0, std::floor(std::log10(std::abs(w))) - p + 1))
+            << v << " p=" << p << ": " << got << " vs " << want;
+      }
+    }
+  EXPECT_LE(mismatches, n / 10000) << mismatches << " of " << n;
+  for (double v : {0.0, -0.0, 1e-4, 0.00012345678901, 123456789.0, 1e300, -5e-300})
+    for (int p : {6, 9}) {
+      std::string got;
+      append_double(got, v, p);
+      char buf[64];
+      const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, p);
+      EXPECT_EQ(got, std::string(buf, res.ptr)) << v;
+    }
 }

@@ -62,7 +62,8 @@ void propagate_covariance(Mat21& P, const ErrorDynamics& d, const ProcessNoise& 
 }
 
 Mat21 transition_matrix(const Mat21& F, double dt) {
-  Mat21 Phi = F * dt;
+  const Mat21 Fdt = F * dt;
+  Mat21 Phi = Fdt + 0.5 * Fdt * Fdt;
   Phi.diagonal().array() += 1.0;
   return Phi;
 }

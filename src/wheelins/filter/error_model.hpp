@@ -20,8 +20,8 @@ using ProcessNoise = ImuNoise;
 Mat21 error_dynamics(const Mat3& C_BtoW, const Vec3& omega_b, const Vec3& f_b,
                      const Vec3& omega_ie_inW, const ProcessNoise& q);
 
-/// The non-zero blocks of F (eq. 2) for one epoch; Phi = I + F dt is applied through
-/// them (apply_transition), never as a dense 21 x 21 product.
+/// The non-zero blocks of F (eq. 2) for one epoch (or their mean over several); Phi is
+/// applied through them (apply_transition), never as a dense 21 x 21 product.
 struct ErrorDynamics {
   Mat3 W = Mat3::Zero();   ///< [w_ie x]
   Mat3 Ff = Mat3::Zero();  ///< [f^w x]
@@ -33,40 +33,52 @@ struct ErrorDynamics {
 ErrorDynamics error_dynamics_blocks(const Mat3& C_BtoW, const Vec3& omega_b, const Vec3& f_b,
                                     const Vec3& omega_ie_inW, const ProcessNoise& q);
 
-/// M <- Phi M for a 21 x K block of rows (Phi = I + F dt), using only F's non-zero blocks.
+/// F M for a 21 x K block of rows, using only F's non-zero blocks (eq. 2).
+template <int K>
+Eigen::Matrix<double, kStateDim, K> apply_dynamics(const ErrorDynamics& d,
+                                                   const Eigen::Matrix<double, kStateDim, K>& M) {
+  Eigen::Matrix<double, kStateDim, K> FM;
+  FM.template middleRows<3>(P) = M.template middleRows<3>(V);
+  FM.template middleRows<3>(V) =
+      -2.0 * d.W * M.template middleRows<3>(V) + d.Ff * M.template middleRows<3>(PHI) +
+      d.C * M.template middleRows<3>(BA) + d.Cf * M.template middleRows<3>(SA);
+  FM.template middleRows<3>(PHI) = -d.W * M.template middleRows<3>(PHI) -
+                                   d.C * M.template middleRows<3>(BG) -
+                                   d.Cw * M.template middleRows<3>(SG);
+  FM.template middleRows<3>(BG) = -d.decay_bg * M.template middleRows<3>(BG);
+  FM.template middleRows<3>(BA) = -d.decay_ba * M.template middleRows<3>(BA);
+  FM.template middleRows<3>(SG) = -d.decay_sg * M.template middleRows<3>(SG);
+  FM.template middleRows<3>(SA) = -d.decay_sa * M.template middleRows<3>(SA);
+  return FM;
+}
+
+/// M <- Phi M for a 21 x K block of rows, Phi = I + F dt + (F dt)^2 / 2: the transition
+/// of eq. (2) to second order in dt, so that one step may span several IMU epochs (the
+/// lower-rate covariance update, StrapdownEkf::set_covariance_interval) with F the mean
+/// over them. Only F's non-zero blocks are used.
 template <int K>
 void apply_transition(const ErrorDynamics& d, double dt, Eigen::Matrix<double, kStateDim, K>& M) {
-  using Rows3 = Eigen::Matrix<double, 3, K>;
-  // Row blocks are updated in an order that reads only rows not yet overwritten.
-  M.template middleRows<3>(P) += dt * M.template middleRows<3>(V);
-  const Rows3 dV = dt * (-2.0 * d.W * M.template middleRows<3>(V) + d.Ff * M.template middleRows<3>(PHI) +
-                         d.C * M.template middleRows<3>(BA) + d.Cf * M.template middleRows<3>(SA));
-  M.template middleRows<3>(V) += dV;
-  const Rows3 dPhi = dt * (-d.W * M.template middleRows<3>(PHI) - d.C * M.template middleRows<3>(BG) -
-                           d.Cw * M.template middleRows<3>(SG));
-  M.template middleRows<3>(PHI) += dPhi;
-  M.template middleRows<3>(BG) *= 1.0 - dt * d.decay_bg;
-  M.template middleRows<3>(BA) *= 1.0 - dt * d.decay_ba;
-  M.template middleRows<3>(SG) *= 1.0 - dt * d.decay_sg;
-  M.template middleRows<3>(SA) *= 1.0 - dt * d.decay_sa;
+  const Eigen::Matrix<double, kStateDim, K> FM = apply_dynamics<K>(d, M);
+  M += dt * FM + (0.5 * dt * dt) * apply_dynamics<K>(d, FM);
 }
 
 /// The discrete process noise Qd = Qc dt (diagonal; the O(dt^2) cross terms of the
 /// trapezoidal rule are below 1e-6 of it at 200 Hz and are left out).
 Vec21 discrete_noise_diagonal(const ProcessNoise& q, double dt);
 
-/// Phi = I + F dt.
+/// Phi = I + F dt + (F dt)^2 / 2 (as apply_transition).
 Mat21 transition_matrix(const Mat21& F, double dt);
 /// The trapezoidal Qd = (Phi Qc Phi^T + Qc) dt / 2.
 Mat21 discrete_noise(const Mat21& Phi, const ProcessNoise& q, double dt);
 
-/// P <- Phi P Phi^T + Qd over dt, with Phi = I + F dt and the trapezoidal
+/// P <- Phi P Phi^T + Qd over dt, with Phi of transition_matrix and the trapezoidal
 /// Qd = (Phi Qc Phi^T + Qc) dt / 2, Qc the diagonal noise density (the noise
 /// enters through C, which is orthogonal, so C Qc C^T = Qc for isotropic sensors).
 void propagate_covariance(Mat21& P, const Mat21& F, const ProcessNoise& q, double dt);
 
-/// The same through the block structure: P <- Phi P Phi^T + Qd with Qd = Qc dt.
-/// About 6 times fewer operations than the dense form; equal to it to O(dt^2).
+/// The same through the block structure: P <- Phi P Phi^T + Qd with Qd = Qc dt and Phi
+/// to second order (apply_transition). Several times fewer operations than the dense
+/// form; equal to it to O(dt^2).
 void propagate_covariance(Mat21& P, const ErrorDynamics& d, const ProcessNoise& q, double dt);
 
 /// Keeps P symmetric (after every step) and its diagonal non-negative.

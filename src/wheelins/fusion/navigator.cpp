@@ -1,6 +1,7 @@
 #include "wheelins/fusion/navigator.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cstdio>
 #include <limits>
@@ -560,7 +561,10 @@ UpdateReport Navigator::fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, 
 }
 
 Mat21 Navigator::covariance(int i) const {
-  return joint_ ? joint_->block(i) : subs_[i]->ekf().covariance();
+  // (subs_ holds unique_ptrs, whose -> gives a non-const Subsystem even here: the const
+  // accessor must be asked for, or every read would propagate P.)
+  const Subsystem& s = *subs_[i];
+  return joint_ ? joint_->block(i) : s.ekf().covariance();
 }
 
 void Navigator::position_update() {
@@ -611,7 +615,8 @@ void Navigator::position_update() {
 TrajectoryRecord Navigator::subsystem_record(int i) const {
   const Subsystem& s = *subs_[i];
   const StrapdownEkf& ekf = s.ekf();
-  const Mat21 P = covariance(i);
+  Mat21 joint_block;
+  const Mat21& P = joint_ ? (joint_block = joint_->block(i)) : ekf.covariance();
   TrajectoryRecord r;
   r.t = ekf.state().t;
   const ReferencePointModel m = reference_point_model(s.reference_point_input());
@@ -628,8 +633,11 @@ TrajectoryRecord Navigator::subsystem_record(int i) const {
     if (body_ && opt_.fusion.share_level) r.rpy.head<2>() = body_->vehicle_rpy().head<2>();
   }
   r.rpy_std.z() = std::sqrt(std::max(0.0, var_psi));
-  // diag(H P H^T) without the full product: row k of H P dotted with row k of H.
-  r.p_std = (m.H.lazyProduct(P)).cwiseProduct(m.H).rowwise().sum().cwiseSqrt();
+  // diag(H P H^T) over the columns eq. (8) depends on: H = [I 0 A 0 ...] over (dr, dv, phi),
+  // so only the top-left 9 x 9 of P enters (the tail of H is zero, checked in debug builds).
+  assert(m.H.rightCols<kStateDim - 9>().isZero());
+  const Eigen::Matrix<double, 3, 9> Hs = m.H.leftCols<9>();
+  r.p_std = Hs.lazyProduct(P.topLeftCorner<9, 9>()).cwiseProduct(Hs).rowwise().sum().cwiseSqrt();
   r.v_std = P.block<3, 3>(V, V).diagonal().cwiseSqrt();
   const ImuErrors& e = ekf.errors();
   r.bg = e.bg;

@@ -57,7 +57,7 @@ struct NavigatorOptions {
   /// Covariance time update every this many seconds, F integrated over the epochs in
   /// between (StrapdownEkf::set_covariance_interval); 0 = every IMU epoch. Measurement
   /// updates always see P propagated to their epoch.
-  double covariance_interval = 0.0;
+  double covariance_interval = 0.05;
   /// The options in human units (OpenVINS style), one per line.
   std::string describe() const;
 };

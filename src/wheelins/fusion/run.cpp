@@ -5,6 +5,7 @@
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/imu_file.hpp"
+#include "wheelins/io/record_pipe.hpp"
 #include "wheelins/util/progress.hpp"
 
 namespace wheelins {
@@ -65,13 +66,21 @@ RunResult run_navigation(const RunRequest& r) {
             make_trajectory_writer(TrajectoryFormat::kCsv, r.output_dir / (m + ".csv"), wopt));
   }
 
+  // Text formatting and file writing run on a second thread (RecordPipe), fed in batches;
+  // the in-memory consumer (on_record) stays on this one.
+  const bool writing = !vehicle.empty() || !subsystems.empty();
+  std::unique_ptr<RecordPipe> pipe;
+  if (writing)
+    pipe = std::make_unique<RecordPipe>([&](int stream, const TrajectoryRecord& rec) {
+      if (stream == 0) {
+        for (auto& w : vehicle) w->write(rec);
+      } else if (!subsystems.empty()) {
+        subsystems[stream - 1]->write(rec);
+      }
+    });
   Navigator nav(r.manifest, r.modules, r.nav, [&](int stream, const TrajectoryRecord& rec) {
-    if (stream == 0) {
-      for (auto& w : vehicle) w->write(rec);
-      if (r.on_record) r.on_record(rec);
-    } else if (!subsystems.empty()) {
-      subsystems[stream - 1]->write(rec);
-    }
+    if (stream == 0 && r.on_record) r.on_record(rec);
+    if (pipe && (stream == 0 || !subsystems.empty())) pipe->push(stream, rec);
   });
 
   Progress progress("navigating", total_rows, r.progress);
@@ -111,6 +120,7 @@ RunResult run_navigation(const RunRequest& r) {
   }
 
   nav.finish();
+  if (pipe) pipe->finish();  // every record written (or the writer's error thrown)
   RunResult result;
   for (auto& w : vehicle) w->commit();
   for (auto& w : subsystems) w->commit();

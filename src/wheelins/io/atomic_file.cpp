@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <system_error>
 
@@ -25,11 +26,78 @@ void check_output_target(const std::filesystem::path& file, bool overwrite) {
                      "e.g. --force, or choose another name)");
 }
 
+namespace {
+
+constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,
+                             1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19};
+
+/// `significant` digits of `value` in the general format (as std::to_chars with
+/// chars_format::general), for the common case where that format is fixed notation
+/// (1e-4 <= |value| < 10^significant, significant <= 12); false otherwise. About 4 times
+/// faster than to_chars: the digits are the integer nearest to |value| * 10^k with an exact
+/// power of ten, so the last digit can differ from correct rounding only when the scaled
+/// value lies within 1e-7 of a half (tests/test_io_imu_file.cpp checks it against to_chars).
+bool append_significant_fixed(std::string& out, double value, int significant) {
+  const double a = std::fabs(value);
+  if (significant < 1 || significant > 12 || !(a >= 1e-4 && a < kPow10[significant])) return false;
+  int bexp = 0;
+  std::frexp(a, &bexp);  // a in [2^(bexp-1), 2^bexp)
+  int e = static_cast<int>(std::floor((bexp - 1) * 0.30102999566398120));  // e or e - 1
+  if (e < -4) e = -4;
+  double digits = 0.0;
+  for (int pass = 0; pass < 3; ++pass) {
+    const int k = significant - 1 - e;  // decimals in fixed notation, 0 .. significant + 3
+    if (k < 0 || k > 19) return false;
+    digits = std::nearbyint(a * kPow10[k]);
+    if (digits >= kPow10[significant]) {
+      ++e;  // one digit too many (e was one low, or rounding carried into a new digit)
+      continue;
+    }
+    if (digits < kPow10[significant - 1]) {
+      --e;
+      continue;
+    }
+    break;
+  }
+  if (e < -4 || e >= significant || digits < kPow10[significant - 1] ||
+      digits >= kPow10[significant])
+    return false;
+  char buf[32];
+  char* end = buf + sizeof buf;
+  char* p = end;
+  auto n = static_cast<std::uint64_t>(digits);
+  int decimals = significant - 1 - e;
+  // Trailing zeros of the fraction are not written (general format).
+  while (decimals > 0 && n % 10 == 0) {
+    n /= 10;
+    --decimals;
+  }
+  for (int i = 0; i < decimals; ++i) {
+    *--p = static_cast<char>('0' + n % 10);
+    n /= 10;
+  }
+  if (decimals > 0) *--p = '.';
+  if (e >= 0) {
+    do {
+      *--p = static_cast<char>('0' + n % 10);
+      n /= 10;
+    } while (n);
+  } else {
+    *--p = '0';  // 0.000ddd: the fraction loop wrote the leading zeros (n ran out)
+  }
+  if (value < 0) *--p = '-';
+  out.append(p, end);
+  return true;
+}
+
+}  // namespace
+
 void append_double(std::string& out, double value, int significant) {
   if (std::isnan(value)) {
     out += "nan";
     return;
   }
+  if (significant > 0 && append_significant_fixed(out, value, significant)) return;
   char buf[64];
   const auto res = significant > 0
                        ? std::to_chars(buf, buf + sizeof(buf), value,
