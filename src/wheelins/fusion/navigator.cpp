@@ -612,7 +612,7 @@ void Navigator::position_update() {
   }
 }
 
-TrajectoryRecord Navigator::subsystem_record(int i) const {
+TrajectoryRecord Navigator::subsystem_record(int i, bool with_lla) const {
   const Subsystem& s = *subs_[i];
   const StrapdownEkf& ekf = s.ekf();
   Mat21 joint_block;
@@ -621,7 +621,8 @@ TrajectoryRecord Navigator::subsystem_record(int i) const {
   r.t = ekf.state().t;
   const ReferencePointModel m = reference_point_model(s.reference_point_input());
   r.p_inN = m.r_o;
-  r.lla = frame_.geodetic_from_ned(r.p_inN);
+  if (with_lla) r.lla = frame_.geodetic_from_ned(r.p_inN);
+  else r.lla.lat = r.lla.lon = r.lla.h = std::numeric_limits<double>::quiet_NaN();
   r.v_inN = s.reference_velocity_inW();
   const Eigen::RowVector3d J = s.heading_sensitivity();
   const double var_psi = J * P.block<3, 3>(PHI, PHI) * J.transpose();
@@ -672,16 +673,20 @@ void Navigator::write_records(double t) {
   const std::array<bool, kMaxModules> use = vehicle_modules();
   const int first = first_used(use);
   const int n = subsystem_count();
+  // Geodetic coordinates only where a record leaves (fuse_records makes the fused one's).
+  const bool modules_out = n > 1 && opt_.module_records;
   for (int i = 0; i < n; ++i)
-    if (use[i] || i == first || (n > 1 && in_use(i))) out_recs_[i] = subsystem_record(i);
+    if (use[i] || i == first || (modules_out && in_use(i)))
+      out_recs_[i] = subsystem_record(i, n == 1);
   TrajectoryRecord v = fuse_records(use, out_recs_);
   v.t = t;  // the epoch of the module driving the output
   sink_(0, v);
-  if (n > 1)
+  if (modules_out)
     for (int i = 0; i < n; ++i)
       // A module whose data have stopped (not yet declared out) has nothing new.
       if (in_use(i) && subs_[i]->time() > rt_[i].last_record_t) {
         rt_[i].last_record_t = subs_[i]->time();
+        out_recs_[i].lla = frame_.geodetic_from_ned(out_recs_[i].p_inN);
         sink_(i + 1, out_recs_[i]);
       }
 }
@@ -704,7 +709,10 @@ TrajectoryRecord Navigator::fuse_records(const std::array<bool, kMaxModules>& us
       ksum += weights_[i];
     }
   TrajectoryRecord r = recs[first_used(use)];
-  if (subs_.size() == 1 || n_use <= 1) return r;
+  if (subs_.size() == 1 || n_use <= 1) {
+    if (!std::isfinite(r.lla.lat)) r.lla = frame_.geodetic_from_ned(r.p_inN);
+    return r;
+  }
   // Output as in the paper: the fused reference point and the mean heading. The 1-sigma
   // of a weighted mean is bounded by the weighted mean of the sigmas whatever the
   // correlation between subsystems (Minkowski), which is what is reported.

@@ -54,6 +54,8 @@ struct NavigatorOptions {
   FaultOptions faults;
   /// Output interval [s]; 0 = every epoch of the first module.
   double output_interval = 0.0;
+  /// Also send each subsystem's own solution to the sink (streams 1..N) of a multi-IMU run.
+  bool module_records = true;
   /// Covariance time update every this many seconds, F integrated over the epochs in
   /// between (StrapdownEkf::set_covariance_interval); 0 = every IMU epoch. Measurement
   /// updates always see P propagated to their epoch.
@@ -166,7 +168,8 @@ class Navigator {
   /// Fuses dz = H dx_i + e into subsystem i (distributed) or the joint state (centralized).
   UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
   Mat21 covariance(int i) const;
-  TrajectoryRecord subsystem_record(int i) const;
+  /// Subsystem i's own solution; without lat/lon/h (left NaN) when with_lla is false.
+  TrajectoryRecord subsystem_record(int i, bool with_lla = true) const;
   /// Weighted mean of the subsystems in `use` (the paper's output, eq. 9).
   TrajectoryRecord fused_record(const std::array<bool, kMaxModules>& use) const;
   using Records = std::array<TrajectoryRecord, kMaxModules>;

@@ -78,7 +78,9 @@ RunResult run_navigation(const RunRequest& r) {
         subsystems[stream - 1]->write(rec);
       }
     });
-  Navigator nav(r.manifest, r.modules, r.nav, [&](int stream, const TrajectoryRecord& rec) {
+  NavigatorOptions nav_opt = r.nav;
+  nav_opt.module_records = !subsystems.empty();  // only when their files are written
+  Navigator nav(r.manifest, r.modules, nav_opt, [&](int stream, const TrajectoryRecord& rec) {
     if (stream == 0 && r.on_record) r.on_record(rec);
     if (pipe && (stream == 0 || !subsystems.empty())) pipe->push(stream, rec);
   });
