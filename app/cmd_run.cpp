@@ -2,6 +2,8 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
+#include <memory>
 #include <sstream>
 
 #include "cli.hpp"
@@ -68,16 +70,41 @@ int run(const RunArgs& a) {
   RunRequest req = make_run_request(cfg, stderr_sink());
   req.progress = !a.quiet;
 
-  // Keep the vehicle solution at 20 Hz in memory to evaluate against the truth.
-  TrajectoryData traj;
-  traj.has_ned = traj.has_lla = traj.has_heading = traj.has_pos_std = true;
-  double next_keep = -1e300;
-  // Only when there is something to evaluate against: the kept solution grows with the run.
+  // Evaluation against the truth as the run goes: the truth file is streamed in step with
+  // the vehicle solution (taken at 20 Hz), so memory stays flat however long the data.
   const bool evaluate = req.manifest.truth_file && !a.no_evaluate;
+  std::unique_ptr<TruthReader> truth;
+  std::unique_ptr<eval::Evaluator> evaluator;
+  TruthRecord next_truth;
+  bool have_next_truth = false;
+  std::string eval_error;  // a bad truth record: reported after the trajectory is written
+  if (evaluate) {
+    truth = std::make_unique<TruthReader>(req.manifest.resolve(*req.manifest.truth_file));
+    eval::Evaluator::Sources src;
+    src.truth_file = truth->file().string();
+    src.traj_file = "the run's vehicle solution";
+    src.traj_format = "memory";
+    src.truth_has_attitude = truth->has_velocity_attitude();
+    evaluator = std::make_unique<eval::Evaluator>(earth::LocalFrame(req.manifest.origin), src,
+                                                  eval::EvalOptions{}, false);
+    have_next_truth = truth->next(next_truth);
+  }
+  double next_keep = -1e300;
+  auto feed_truth_before = [&](double t) {
+    while (have_next_truth && next_truth.t < t) {
+      evaluator->add_truth(next_truth);
+      have_next_truth = truth->next(next_truth);
+    }
+  };
   if (evaluate) req.on_record = [&](const TrajectoryRecord& r) {
-    if (r.t + 1e-9 < next_keep) return;
-    traj.records.push_back(r);
+    if (!eval_error.empty() || r.t + 1e-9 < next_keep) return;
     next_keep = r.t + 0.05;
+    try {
+      feed_truth_before(r.t);
+      evaluator->add_trajectory(r);
+    } catch (const InputError& e) {
+      eval_error = e.what();
+    }
   };
 
   std::cout << "wheelins run: " << cfg.configuration << " [";
@@ -108,9 +135,16 @@ int run(const RunArgs& a) {
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
 
   if (evaluate) {
-    const TruthData truth = read_truth(req.manifest.resolve(*req.manifest.truth_file));
-    const eval::EvalResult e = eval::evaluate(truth, traj, earth::LocalFrame(req.manifest.origin));
-    std::printf("\nagainst the truth (%s):\n", truth.file.string().c_str());
+    if (eval_error.empty()) {
+      try {
+        feed_truth_before(std::numeric_limits<double>::infinity());
+      } catch (const InputError& e) {
+        eval_error = e.what();
+      }
+    }
+    if (!eval_error.empty()) throw InputError(eval_error + " (the trajectory was written)");
+    const eval::EvalResult e = evaluator->finish();
+    std::printf("\nagainst the truth (%s):\n", truth->file().string().c_str());
     std::printf("  distance            %10.1f m\n", e.distance);
     std::printf("  drift rate          %10.3f %% of distance (l = %.0f m)\n", 100.0 * e.drift_rate,
                 e.segment_length);
@@ -139,8 +173,8 @@ const bool registered = cli::register_command(
       sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
       sub.add_flag("--no-evaluate", a->no_evaluate,
-                   "Do not evaluate against the manifest's truth (the evaluation holds the truth "
-                   "and the 20 Hz solution in memory; without it memory stays flat)");
+                   "Do not evaluate against the manifest's truth (the evaluation streams the truth "
+                   "file alongside the run)");
       sub.add_flag("--no-fault-handling", a->no_faults,
                    "Use every sample and module as it comes (no outage, saturation, slip or "
                    "fault isolation)");

@@ -294,3 +294,43 @@ TEST(EvalMetrics, LatLonTrajectoryUsesFrameAndErrorsWithoutOverlap) {
     EXPECT_NE(msg.find("truth.bin"), std::string::npos) << msg;
   }
 }
+
+TEST(EvalMetrics, StreamingEvaluatorKeepsConstantMemoryAndMatchesEvaluate) {
+  // 2000 s of a 200 Hz truth against a 20 Hz trajectory with a growing error, fed in step
+  // as `wheelins run` does: the evaluator never holds more than the truth records between
+  // two trajectory records, and its result is evaluate()'s.
+  const earth::LocalFrame frame(kOrigin);
+  auto pos = [](double t) { return Vec3(1.2 * t, 30.0 * std::sin(0.01 * t), 0.0); };
+  auto err = [](double t) { return Vec3(0.001 * t, -0.0005 * t, 0.0); };
+  const TruthData truth = make_truth(frame, 0.0, 2000.0, 0.005, pos, [](double t) { return 0.01 * t; });
+  const TrajectoryData traj = make_traj(
+      1.0, 1999.0, 0.05, [&](double t) { return Vec3(pos(t) + err(t)); },
+      [](double t) { return 0.01 * t + 0.002; });
+  const EvalResult batch = evaluate(truth, traj, frame);
+
+  Evaluator::Sources src;
+  src.truth_file = "truth.bin";
+  src.traj_file = "traj.csv";
+  src.traj_has_lla = false;
+  src.traj_has_sigma = false;
+  Evaluator ev(frame, src, {}, false);
+  std::size_t i = 0, max_pending = 0;
+  for (const TrajectoryRecord& r : traj.records) {
+    while (i < truth.records.size() && truth.records[i].t < r.t) ev.add_truth(truth.records[i++]);
+    ev.add_trajectory(r);
+    max_pending = std::max(max_pending, ev.pending());
+  }
+  while (i < truth.records.size()) ev.add_truth(truth.records[i++]);
+  const EvalResult s = ev.finish();
+  EXPECT_LE(max_pending, 11u);  // 0.05 s of 200 Hz truth
+  EXPECT_TRUE(s.series.empty());
+  EXPECT_EQ(s.epochs, batch.epochs);
+  EXPECT_EQ(s.skipped_outside, batch.skipped_outside);
+  EXPECT_EQ(s.skipped_outside, 400u);  // the first and the last second of the truth
+  EXPECT_DOUBLE_EQ(s.drift_rate, batch.drift_rate);
+  EXPECT_EQ(s.drift_curve, batch.drift_curve);
+  EXPECT_DOUBLE_EQ(s.heading_rmse, batch.heading_rmse);
+  EXPECT_NEAR(s.heading_rmse, 0.002, 1e-9);
+  EXPECT_DOUBLE_EQ(s.max_error, batch.max_error);
+  EXPECT_GT(s.drift_rate, 0.0);
+}

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
+#include <stdexcept>
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/nav/types.hpp"
@@ -14,36 +16,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kTimeSlack = 1e-6;  // [s] end-point tolerance of the time brackets
 
 std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
-
-// The trajectory as evaluation needs it: positions in the evaluation frame.
-struct Track {
-  std::vector<double> t;
-  std::vector<Vec3> p;
-  std::vector<double> heading;
-  std::vector<double> sn, se;  // north / east 1-sigma
-};
-
-Track make_track(const TrajectoryData& traj, const earth::LocalFrame& frame) {
-  Track k;
-  const std::size_t n = traj.records.size();
-  k.t.reserve(n);
-  k.p.reserve(n);
-  if (traj.has_heading) k.heading.reserve(n);
-  if (traj.has_pos_std) {
-    k.sn.reserve(n);
-    k.se.reserve(n);
-  }
-  for (const auto& r : traj.records) {
-    k.t.push_back(r.t);
-    k.p.push_back(traj.has_lla ? frame.ned_from_geodetic(r.lla) : r.p_inN);
-    if (traj.has_heading) k.heading.push_back(r.rpy.z());
-    if (traj.has_pos_std) {
-      k.sn.push_back(r.p_std.x());
-      k.se.push_back(r.p_std.y());
-    }
-  }
-  return k;
-}
 
 double lerp(double a, double b, double f) { return a + (b - a) * f; }
 
@@ -67,37 +39,34 @@ std::vector<double> drift_rate_curve(const std::vector<double>& s, const std::ve
   return curve;
 }
 
-EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
-                    const earth::LocalFrame& frame, const EvalOptions& opt) {
-  if (!(opt.segment_length > 0.0) || !std::isfinite(opt.segment_length))
-    throw InputError("segment length must be a positive number of metres");
-  if (!(opt.max_gap > 0.0)) throw InputError("maximum interpolation gap must be positive");
-  if (truth.records.empty()) throw InputError(quote(truth.file) + ": no truth records");
-  if (traj.records.empty()) throw InputError(quote(traj.file) + ": no trajectory records");
+// ------------------------------------------------------------------ Evaluator
 
+struct Evaluator::State {
+  struct Sample {  // one trajectory record, positions in the evaluation frame
+    double t = 0.0;
+    Vec3 p = Vec3::Zero();
+    double heading = kNaN, sn = kNaN, se = kNaN;
+  };
+  struct Truth {  // one truth record with its position and path length
+    double t = 0.0, heading = kNaN, s = 0.0;
+    Vec3 p = Vec3::Zero();
+  };
+
+  earth::LocalFrame frame;
+  Sources src;
+  EvalOptions opt;
+  bool keep_series = false;
   EvalResult res;
-  res.truth_file = truth.file.string();
-  res.traj_file = traj.file.string();
-  res.traj_format = trajectory_format_name(traj.format);
-  res.truth_records = truth.records.size();
-  res.traj_records = traj.records.size();
-  res.segment_length = opt.segment_length;
-  res.has_heading = truth.has_velocity_attitude && traj.has_heading;
-  res.has_sigma = traj.has_pos_std;
 
-  const Track track = make_track(traj, frame);
-  const std::size_t m = track.t.size();
+  Sample a, b;          // the last two trajectory samples (b the latest)
+  std::size_t n_traj = 0;
+  double first_traj_t = 0.0;
+  std::deque<Truth> pending;
+  bool have_truth = false;
+  Vec3 last_truth_p = Vec3::Zero();
+  double truth_s = 0.0, first_truth_t = 0.0, last_truth_t = 0.0;
 
-  // Truth positions and cumulative horizontal distance over all records.
-  const std::size_t n = truth.records.size();
-  std::vector<Vec3> tp(n);
-  std::vector<double> ts(n, 0.0);
-  for (std::size_t i = 0; i < n; ++i) {
-    tp[i] = frame.ned_from_geodetic(truth.records[i].lla);
-    if (i > 0) ts[i] = ts[i - 1] + (tp[i] - tp[i - 1]).head<2>().norm();
-  }
-
-  // Alignment state, fixed at the first evaluated epoch.
+  // Alignment, fixed at the first evaluated epoch.
   bool pivot_set = false;
   Vec3 pivot_traj = Vec3::Zero(), pivot_truth = Vec3::Zero();
   Mat3 R = Mat3::Identity();
@@ -106,44 +75,40 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
 
   double s0 = 0.0, sum_e2 = 0.0, sum_h2 = 0.0, max_h = 0.0, sum_nees = 0.0;
   std::size_t heading_count = 0, within = 0;
-  res.series.reserve(n);
-  std::size_t j = 0;  // trajectory bracket: track.t[j] <= t < track.t[j+1]
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = truth.records[i].t;
-    if (t < track.t.front() - kTimeSlack || t > track.t.back() + kTimeSlack) {
-      ++res.skipped_outside;
-      continue;
-    }
-    while (j + 1 < m && track.t[j + 1] <= t) ++j;
-    std::size_t j1 = j;
-    double f = 0.0;
-    if (j + 1 < m && t > track.t[j]) {
-      j1 = j + 1;
-      const double span = track.t[j1] - track.t[j];
-      if (span > opt.max_gap) {
-        ++res.skipped_gap;
-        continue;
-      }
-      f = std::clamp((t - track.t[j]) / span, 0.0, 1.0);
-    }
-    Vec3 p = track.p[j] + (track.p[j1] - track.p[j]) * f;
-    double heading = kNaN;
-    if (traj.has_heading)
-      heading = track.heading[j] + wrap_pi(track.heading[j1] - track.heading[j]) * f;
-    const double truth_heading =
-        truth.has_velocity_attitude ? truth.records[i].rpy.z() : kNaN;
+  EpochError last;
 
+  // Drift curve (r_k = max{e_h : s <= k l} / (k l)), built as the epochs come.
+  double running_max = 0.0;
+
+  State(const earth::LocalFrame& f, const Sources& s, const EvalOptions& o, bool keep)
+      : frame(f), src(s), opt(o), keep_series(keep) {}
+
+  void drift_add(double dist, double err) {
+    const double slack = 1e-9 * std::max(1.0, dist);
+    for (;;) {
+      const double limit = static_cast<double>(res.drift_curve.size() + 1) * opt.segment_length;
+      if (dist <= limit + slack) break;
+      res.drift_curve.push_back(running_max / limit);
+    }
+    running_max = std::max(running_max, err);
+  }
+
+  // Truth record x against the trajectory between samples lo and hi at fraction f.
+  void epoch(const Truth& x, const Sample& lo, const Sample& hi, double f) {
+    Vec3 p = lo.p + (hi.p - lo.p) * f;
+    double heading = kNaN;
+    if (src.traj_has_heading) heading = lo.heading + wrap_pi(hi.heading - lo.heading) * f;
     if (!pivot_set) {
       pivot_set = true;
-      s0 = ts[i];
-      res.t_start = t;
+      s0 = x.s;
+      res.t_start = x.t;
       if (opt.align) {
         res.aligned = true;
         pivot_traj = p;
-        pivot_truth = tp[i];
+        pivot_truth = x.p;
         res.align_offset = pivot_truth - pivot_traj;
-        if (std::isfinite(heading) && std::isfinite(truth_heading)) {
-          dpsi = wrap_pi(truth_heading - heading);
+        if (std::isfinite(heading) && std::isfinite(x.heading)) {
+          dpsi = wrap_pi(x.heading - heading);
           res.align_rotated = true;
           res.align_yaw = dpsi;
           R = rot_z(dpsi);
@@ -155,21 +120,19 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
       p = R * (p - pivot_traj) + pivot_truth;
       heading += dpsi;
     }
-
     EpochError e;
-    e.t = t;
-    e.distance = ts[i] - s0;
-    e.err_ned = p - tp[i];
+    e.t = x.t;
+    e.distance = x.s - s0;
+    e.err_ned = p - x.p;
     e.err_h = e.err_ned.head<2>().norm();
-    e.heading_err = res.has_heading ? wrap_pi(heading - truth_heading) : kNaN;
+    e.heading_err = res.has_heading ? wrap_pi(heading - x.heading) : kNaN;
     e.sigma_h = kNaN;
     e.nees_h = kNaN;
     if (res.has_sigma) {
-      const double sn = lerp(track.sn[j], track.sn[j1], f);
-      const double se = lerp(track.se[j], track.se[j1], f);
+      const double sn = lerp(lo.sn, hi.sn, f);
+      const double se = lerp(lo.se, hi.se, f);
       if (sn > 0.0 && se > 0.0 && std::isfinite(sn) && std::isfinite(se)) {
-        const Eigen::Matrix2d P =
-            R2 * Eigen::Vector2d(sn * sn, se * se).asDiagonal() * R2.transpose();
+        const Eigen::Matrix2d P = R2 * Eigen::Vector2d(sn * sn, se * se).asDiagonal() * R2.transpose();
         const Eigen::Vector2d d = e.err_ned.head<2>();
         e.sigma_h = std::sqrt(P.trace());
         e.nees_h = d.dot(P.ldlt().solve(d));
@@ -185,32 +148,128 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
       max_h = std::max(max_h, std::abs(e.heading_err));
       ++heading_count;
     }
-    res.series.push_back(e);
+    drift_add(e.distance, e.err_h);
+    ++res.epochs;
+    last = e;
+    if (keep_series) res.series.push_back(e);
   }
 
-  res.epochs = res.series.size();
+  // Evaluates the pending truth records that the trajectory now brackets: those before
+  // the latest sample b (bracket a..b), or all of them at the end (final).
+  void drain(bool final) {
+    while (!pending.empty()) {
+      const Truth& x = pending.front();
+      if (n_traj == 0 || x.t < first_traj_t - kTimeSlack) {
+        if (n_traj == 0 && !final) return;
+        ++res.skipped_outside;
+      } else if (x.t < b.t) {
+        // a.t <= x.t < b.t (or x before the first sample within the slack: its value).
+        if (n_traj == 1 || x.t <= a.t) {
+          epoch(x, n_traj == 1 ? b : a, n_traj == 1 ? b : a, 0.0);
+        } else {
+          const double span = b.t - a.t;
+          if (span > opt.max_gap) ++res.skipped_gap;
+          else epoch(x, a, b, std::clamp((x.t - a.t) / span, 0.0, 1.0));
+        }
+      } else if (!final) {
+        return;  // at or after the latest sample: wait for the next one
+      } else if (x.t <= b.t + kTimeSlack) {
+        epoch(x, b, b, 0.0);
+      } else {
+        ++res.skipped_outside;
+      }
+      pending.pop_front();
+    }
+  }
+};
+
+Evaluator::Evaluator(const earth::LocalFrame& frame, const Sources& sources,
+                     const EvalOptions& opt, bool keep_series) {
+  if (!(opt.segment_length > 0.0) || !std::isfinite(opt.segment_length))
+    throw InputError("segment length must be a positive number of metres");
+  if (!(opt.max_gap > 0.0)) throw InputError("maximum interpolation gap must be positive");
+  s_ = std::make_unique<State>(frame, sources, opt, keep_series);
+  EvalResult& r = s_->res;
+  r.truth_file = sources.truth_file;
+  r.traj_file = sources.traj_file;
+  r.traj_format = sources.traj_format;
+  r.segment_length = opt.segment_length;
+  r.has_heading = sources.truth_has_attitude && sources.traj_has_heading;
+  r.has_sigma = sources.traj_has_sigma;
+}
+
+Evaluator::~Evaluator() = default;
+
+double Evaluator::trajectory_time() const {
+  return s_->n_traj ? s_->b.t : -std::numeric_limits<double>::infinity();
+}
+
+std::size_t Evaluator::pending() const { return s_->pending.size(); }
+
+void Evaluator::add_truth(const TruthRecord& r) {
+  State& s = *s_;
+  State::Truth x;
+  x.t = r.t;
+  x.p = s.frame.ned_from_geodetic(r.lla);
+  x.heading = s.src.truth_has_attitude ? r.rpy.z() : kNaN;
+  // Path length over every consecutive truth record (horizontal).
+  if (s.have_truth) s.truth_s += (x.p - s.last_truth_p).head<2>().norm();
+  else s.first_truth_t = r.t;
+  x.s = s.truth_s;
+  s.have_truth = true;
+  s.last_truth_p = x.p;
+  s.last_truth_t = r.t;
+  ++s.res.truth_records;
+  if (s.n_traj >= 2 && x.t < s.a.t && x.t >= s.first_traj_t - kTimeSlack)
+    throw std::logic_error("Evaluator: a truth record came after the trajectory had passed it");
+  s.pending.push_back(x);
+  s.drain(false);
+}
+
+void Evaluator::add_trajectory(const TrajectoryRecord& r) {
+  State& s = *s_;
+  State::Sample k;
+  k.t = r.t;
+  k.p = s.src.traj_has_lla ? s.frame.ned_from_geodetic(r.lla) : r.p_inN;
+  if (s.src.traj_has_heading) k.heading = r.rpy.z();
+  if (s.src.traj_has_sigma) {
+    k.sn = r.p_std.x();
+    k.se = r.p_std.y();
+  }
+  if (s.n_traj == 0) s.first_traj_t = r.t;
+  s.a = s.n_traj ? s.b : k;
+  s.b = k;
+  ++s.n_traj;
+  ++s.res.traj_records;
+  s.drain(false);
+}
+
+EvalResult Evaluator::finish() {
+  State& s = *s_;
+  s.drain(true);
+  EvalResult& res = s.res;
+  if (res.truth_records == 0) throw InputError(quote(res.truth_file) + ": no truth records");
+  if (s.n_traj == 0) throw InputError(quote(res.traj_file) + ": no trajectory records");
   if (res.epochs == 0)
-    throw InputError(quote(traj.file) + ": no truth epoch of " + quote(truth.file) +
-                     " falls inside the trajectory (trajectory " + std::to_string(track.t.front()) +
-                     " .. " + std::to_string(track.t.back()) + " s, truth " +
-                     std::to_string(truth.records.front().t) + " .. " +
-                     std::to_string(truth.records.back().t) + " s" +
+    throw InputError(quote(res.traj_file) + ": no truth epoch of " + quote(res.truth_file) +
+                     " falls inside the trajectory (trajectory " + std::to_string(s.first_traj_t) +
+                     " .. " + std::to_string(s.b.t) + " s, truth " +
+                     std::to_string(s.first_truth_t) + " .. " + std::to_string(s.last_truth_t) +
+                     " s" +
                      (res.skipped_gap ? ", or only inside gaps longer than the maximum gap" : "") +
                      "); do both use the same time scale (GPS seconds of week)?");
-
-  const auto& last = res.series.back();
-  res.t_end = last.t;
+  res.t_end = s.last.t;
   res.duration = res.t_end - res.t_start;
-  res.distance = last.distance;
-  res.final_error = last.err_h;
-  res.rms_error = std::sqrt(sum_e2 / static_cast<double>(res.epochs));
-
-  std::vector<double> s(res.epochs), err(res.epochs);
-  for (std::size_t k = 0; k < res.epochs; ++k) {
-    s[k] = res.series[k].distance;
-    err[k] = res.series[k].err_h;
-  }
-  res.drift_curve = drift_rate_curve(s, err, opt.segment_length);
+  res.distance = s.last.distance;
+  res.final_error = s.last.err_h;
+  res.rms_error = std::sqrt(s.sum_e2 / static_cast<double>(res.epochs));
+  // The segments completed by the total distance (same slack as drift_rate_curve()).
+  const double slack = 1e-9 * std::max(1.0, res.distance);
+  const auto K = static_cast<std::size_t>(std::floor((res.distance + slack) / res.segment_length));
+  while (res.drift_curve.size() < K)
+    res.drift_curve.push_back(s.running_max /
+                              (static_cast<double>(res.drift_curve.size() + 1) * res.segment_length));
+  res.drift_curve.resize(K);
   if (res.drift_curve.empty()) {
     res.drift_rate = kNaN;
   } else {
@@ -218,22 +277,44 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
     for (double r : res.drift_curve) sum += r;
     res.drift_rate = sum / static_cast<double>(res.drift_curve.size());
   }
-
-  if (heading_count > 0) {
-    res.heading_rmse = std::sqrt(sum_h2 / static_cast<double>(heading_count));
-    res.heading_max_abs = max_h;
+  if (s.heading_count > 0) {
+    res.heading_rmse = std::sqrt(s.sum_h2 / static_cast<double>(s.heading_count));
+    res.heading_max_abs = s.max_h;
   } else {
     res.has_heading = false;
     res.heading_rmse = res.heading_max_abs = kNaN;
   }
   if (res.sigma_epochs > 0) {
-    res.within_3sigma = static_cast<double>(within) / static_cast<double>(res.sigma_epochs);
-    res.mean_nees = sum_nees / static_cast<double>(res.sigma_epochs);
+    res.within_3sigma = static_cast<double>(s.within) / static_cast<double>(res.sigma_epochs);
+    res.mean_nees = s.sum_nees / static_cast<double>(res.sigma_epochs);
   } else {
     res.has_sigma = false;
     res.within_3sigma = res.mean_nees = kNaN;
   }
   return res;
+}
+
+EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
+                    const earth::LocalFrame& frame, const EvalOptions& opt) {
+  Evaluator::Sources src;
+  src.truth_file = truth.file.string();
+  src.traj_file = traj.file.string();
+  src.traj_format = trajectory_format_name(traj.format);
+  src.truth_has_attitude = truth.has_velocity_attitude;
+  src.traj_has_lla = traj.has_lla;
+  src.traj_has_heading = traj.has_heading;
+  src.traj_has_sigma = traj.has_pos_std;
+  Evaluator ev(frame, src, opt, true);
+  if (truth.records.empty()) throw InputError(quote(truth.file) + ": no truth records");
+  if (traj.records.empty()) throw InputError(quote(traj.file) + ": no trajectory records");
+  // In step: the truth records before each trajectory record go in first.
+  std::size_t i = 0;
+  for (const TrajectoryRecord& r : traj.records) {
+    while (i < truth.records.size() && truth.records[i].t < r.t) ev.add_truth(truth.records[i++]);
+    ev.add_trajectory(r);
+  }
+  while (i < truth.records.size()) ev.add_truth(truth.records[i++]);
+  return ev.finish();
 }
 
 namespace {

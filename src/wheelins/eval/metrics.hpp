@@ -37,6 +37,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,42 @@ struct EvalResult {
 /// non-decreasing distances from 0. Empty when s.back() < l.
 std::vector<double> drift_rate_curve(const std::vector<double>& s, const std::vector<double>& err,
                                      double segment_length);
+
+/// The evaluation of evaluate(), fed record by record. The truth and the trajectory
+/// are each fed in time order, a truth record before any trajectory record later than
+/// it; the evaluator keeps only the last two trajectory samples and the truth records
+/// not yet bracketed by them, so its memory is constant when the two are fed in step
+/// (the per-epoch series is kept only on request). The definitions are those above.
+class Evaluator {
+ public:
+  struct Sources {
+    std::string truth_file, traj_file, traj_format;
+    bool truth_has_attitude = true;  ///< truth headings available
+    bool traj_has_lla = true;        ///< trajectory positions from lla (else p_inN)
+    bool traj_has_heading = true;
+    bool traj_has_sigma = true;      ///< north/east 1-sigma in p_std
+  };
+  /// Throws InputError for options out of range.
+  Evaluator(const earth::LocalFrame& frame, const Sources& sources, const EvalOptions& options,
+            bool keep_series);
+  ~Evaluator();
+  Evaluator(const Evaluator&) = delete;
+  Evaluator& operator=(const Evaluator&) = delete;
+
+  void add_truth(const TruthRecord& r);
+  void add_trajectory(const TrajectoryRecord& r);
+  /// Time of the latest trajectory record (-inf before the first).
+  double trajectory_time() const;
+  /// Truth records waiting for the trajectory to reach them.
+  std::size_t pending() const;
+  /// The result; InputError (naming the files) when no truth epoch fell inside the
+  /// trajectory.
+  EvalResult finish();
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
 
 /// Compares `traj` with `truth` in `frame` (the local NED frame both are expressed
 /// in). Trajectory records with lat/lon/h are mapped into `frame`; records with

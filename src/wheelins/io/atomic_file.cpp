@@ -1,5 +1,6 @@
 #include "wheelins/io/atomic_file.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -31,15 +32,16 @@ namespace {
 constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,
                              1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19};
 
-/// `significant` digits of `value` in the general format (as std::to_chars with
-/// chars_format::general), for the common case where that format is fixed notation
-/// (1e-4 <= |value| < 10^significant, significant <= 12); false otherwise. About 4 times
-/// faster than to_chars: the digits are the integer nearest to |value| * 10^k with an exact
-/// power of ten, so the last digit can differ from correct rounding only when the scaled
-/// value lies within 1e-7 of a half (tests/test_io_imu_file.cpp checks it against to_chars).
-bool append_significant_fixed(std::string& out, double value, int significant) {
+/// Writes `significant` digits of `value` in the general format (as std::to_chars with
+/// chars_format::general) for the common case where that format is fixed notation
+/// (1e-4 <= |value| < 10^significant, significant <= 12), returning the end; nullptr
+/// otherwise. About 4 times faster than to_chars: the digits are the integer nearest to
+/// |value| * 10^k with an exact power of ten, so the last digit can differ from correct
+/// rounding only when the scaled value lies within 1e-7 of a half
+/// (IoText.SignificantDigitsMatchToChars checks it against to_chars).
+char* significant_fixed(char* dst, double value, int significant) {
   const double a = std::fabs(value);
-  if (significant < 1 || significant > 12 || !(a >= 1e-4 && a < kPow10[significant])) return false;
+  if (significant < 1 || significant > 12 || !(a >= 1e-4 && a < kPow10[significant])) return nullptr;
   int bexp = 0;
   std::frexp(a, &bexp);  // a in [2^(bexp-1), 2^bexp)
   int e = static_cast<int>(std::floor((bexp - 1) * 0.30102999566398120));  // e or e - 1
@@ -47,7 +49,7 @@ bool append_significant_fixed(std::string& out, double value, int significant) {
   double digits = 0.0;
   for (int pass = 0; pass < 3; ++pass) {
     const int k = significant - 1 - e;  // decimals in fixed notation, 0 .. significant + 3
-    if (k < 0 || k > 19) return false;
+    if (k < 0 || k > 19) return nullptr;
     digits = std::nearbyint(a * kPow10[k]);
     if (digits >= kPow10[significant]) {
       ++e;  // one digit too many (e was one low, or rounding carried into a new digit)
@@ -61,7 +63,7 @@ bool append_significant_fixed(std::string& out, double value, int significant) {
   }
   if (e < -4 || e >= significant || digits < kPow10[significant - 1] ||
       digits >= kPow10[significant])
-    return false;
+    return nullptr;
   char buf[32];
   char* end = buf + sizeof buf;
   char* p = end;
@@ -86,24 +88,30 @@ bool append_significant_fixed(std::string& out, double value, int significant) {
     *--p = '0';  // 0.000ddd: the fraction loop wrote the leading zeros (n ran out)
   }
   if (value < 0) *--p = '-';
-  out.append(p, end);
-  return true;
+  const auto len = static_cast<std::size_t>(end - p);
+  std::memcpy(dst, p, len);
+  return dst + len;
 }
 
 }  // namespace
 
-void append_double(std::string& out, double value, int significant) {
+char* format_double(char* dst, double value, int significant) {
+  significant = std::min(significant, 17);  // a double has no more; fits kMaxDoubleChars
   if (std::isnan(value)) {
-    out += "nan";
-    return;
+    std::memcpy(dst, "nan", 3);
+    return dst + 3;
   }
-  if (significant > 0 && append_significant_fixed(out, value, significant)) return;
-  char buf[64];
-  const auto res = significant > 0
-                       ? std::to_chars(buf, buf + sizeof(buf), value,
-                                       std::chars_format::general, significant)
-                       : std::to_chars(buf, buf + sizeof(buf), value);
-  out.append(buf, res.ptr);
+  if (significant > 0)
+    if (char* end = significant_fixed(dst, value, significant)) return end;
+  const auto res = significant > 0 ? std::to_chars(dst, dst + kMaxDoubleChars, value,
+                                                   std::chars_format::general, significant)
+                                   : std::to_chars(dst, dst + kMaxDoubleChars, value);
+  return res.ptr;
+}
+
+void append_double(std::string& out, double value, int significant) {
+  char buf[kMaxDoubleChars];
+  out.append(buf, format_double(buf, value, significant));
 }
 
 void append_fixed(std::string& out, double value, int decimals) {

@@ -16,6 +16,9 @@ void check_output_target(const std::filesystem::path& file, bool overwrite);
 /// Appends `value` to `out`: the shortest text that reads back to the same double
 /// when `significant` is 0, otherwise that many significant digits. NaN -> "nan".
 void append_double(std::string& out, double value, int significant = 0);
+/// The same into `dst`, which must have room for kMaxDoubleChars; returns the end.
+constexpr int kMaxDoubleChars = 32;
+char* format_double(char* dst, double value, int significant = 0);
 /// Appends `value` with a fixed number of decimals (e.g. degrees in KML).
 void append_fixed(std::string& out, double value, int decimals);
 

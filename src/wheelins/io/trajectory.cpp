@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <system_error>
 
 #include "wheelins/io/atomic_file.hpp"
@@ -50,6 +51,8 @@ struct CsvColumn {
   CsvColumn{name, [](const TrajectoryRecord& r) { return (expr_get) / (scale); }, \
             [](TrajectoryRecord& r, double v) { lhs = v * (scale); }, full}
 
+constexpr std::size_t kMaxCsvColumns = 64;  // room of CsvWriter's line buffer
+
 const std::vector<CsvColumn>& csv_columns() {
   static const std::vector<CsvColumn> cols = {
       WHEELINS_COL("t_s", r.t, r.t, 1.0, true),
@@ -83,6 +86,7 @@ const std::vector<CsvColumn>& csv_columns() {
       WHEELINS_VEC_COLS("sg", sg_std, "_std_ppm", kPpm, false),
       WHEELINS_VEC_COLS("sa", sa_std, "_std_ppm", kPpm, false),
   };
+  if (cols.size() > kMaxCsvColumns) throw std::logic_error("CSV layout: raise kMaxCsvColumns");
   return cols;
 }
 #undef WHEELINS_VEC_COLS
@@ -117,14 +121,16 @@ class CsvWriter final : public TrajectoryWriter {
   }
   void write(const TrajectoryRecord& rec) override {
     order_.check(out_.file(), n_, rec.t);
-    std::string& b = out_.buffer();
-    bool first = true;
+    // The line is formatted into a local buffer and appended once.
+    char line[kMaxCsvColumns * (kMaxDoubleChars + 1)];
+    char* p = line;
     for (const auto& c : csv_columns()) {
-      if (!first) b += ',';
-      first = false;
-      append_double(b, c.get(rec), c.full_precision ? 0 : kStdDigits);
+      p = format_double(p, c.get(rec), c.full_precision ? 0 : kStdDigits);
+      *p++ = ',';
     }
-    b += '\n';
+    if (p == line) *p++ = '\n';  // (no columns: cannot happen)
+    else p[-1] = '\n';           // the last separator becomes the line end
+    out_.buffer().append(line, p);
     out_.maybe_flush();
     ++n_;
   }

@@ -108,67 +108,76 @@ TruthLayout detect_truth_layout(const std::filesystem::path& file) {
                    "increasing time, lat/lon); give the layout explicitly (gins11 or pos5)");
 }
 
-TruthData read_truth(const std::filesystem::path& file, TruthLayout layout) {
-  if (layout == TruthLayout::kAuto) layout = detect_truth_layout(file);
-  const int ncols = layout == TruthLayout::kGins11 ? kCols11 : kCols5;
-  BinaryRowReader rd(file, ncols);
-  if (rd.rows() == 0) throw InputError(quote(file) + ": empty truth file");
+TruthReader::TruthReader(const std::filesystem::path& file, TruthLayout layout)
+    : file_(file), layout_(layout == TruthLayout::kAuto ? detect_truth_layout(file) : layout) {
+  rows_ = std::make_unique<BinaryRowReader>(file, layout_ == TruthLayout::kGins11 ? kCols11 : kCols5);
+  if (rows_->rows() == 0) throw InputError(quote(file) + ": empty truth file");
+}
 
-  TruthData out;
-  out.file = file;
-  out.layout = layout;
-  out.has_velocity_attitude = layout == TruthLayout::kGins11;
-  out.records.reserve(rd.rows());
+TruthReader::~TruthReader() = default;
 
-  double first_week = 0.0, prev_t = -INFINITY;
+std::uint64_t TruthReader::rows() const { return rows_->rows(); }
+
+bool TruthReader::next(TruthRecord& rec) {
+  const double* r = rows_->next();
+  if (!r) return false;
+  const std::uint64_t i = rows_->index();
+  const bool gins = layout_ == TruthLayout::kGins11;
   static const char* const kNames11[kCols11] = {"gps_week", "t",  "lat",  "lon",   "h",  "vn",
                                                 "ve",       "vd", "roll", "pitch", "yaw"};
   static const char* const kNames5[4] = {"t", "lat", "lon", "h"};
-  while (const double* r = rd.next()) {
-    const std::uint64_t i = rd.index();
-    const int checked = layout == TruthLayout::kGins11 ? kCols11 : 4;
-    for (int c = 0; c < checked; ++c)
-      if (!std::isfinite(r[c]))
-        throw InputError(where(file, i) + "column " + std::to_string(c) + " (" +
-                         (layout == TruthLayout::kGins11 ? kNames11[c] : kNames5[c]) +
-                         ") is " + num(r[c]) + "; values must be finite");
-    TruthRecord rec;
-    double lat_deg, lon_deg;
-    if (layout == TruthLayout::kGins11) {
-      const double week = r[0];
-      if (week < 0.0 || week != std::floor(week))
-        throw InputError(where(file, i) + "GPS week " + num(week) +
-                         " is not a non-negative integer (is this an 11-column GINS file?)");
-      if (i == 0) {
-        first_week = week;
-        out.gps_week = week;
-      }
-      if (week < first_week)
-        throw InputError(where(file, i) + "GPS week " + num(week) +
-                         " is before the first record's week " + num(first_week));
-      rec.t = r[1] + kWeekSeconds * (week - first_week);
-      lat_deg = r[2];
-      lon_deg = r[3];
-      rec.lla.h = r[4];
-      rec.v_ned = Vec3(r[5], r[6], r[7]);
-      rec.rpy = Vec3(r[8], r[9], r[10]) * kDeg;
-    } else {
-      rec.t = r[0];
-      lat_deg = r[1];
-      lon_deg = r[2];
-      rec.lla.h = r[3];
-    }
-    if (!lat_lon_ok(lat_deg, lon_deg))
-      throw InputError(where(file, i) + "latitude " + num(lat_deg) + " / longitude " +
-                       num(lon_deg) + " deg out of range (|lat| <= 90, |lon| <= 180)");
-    if (!(rec.t > prev_t))
-      throw InputError(where(file, i) + "time " + num(rec.t) +
-                       " s does not increase (previous record: " + num(prev_t) + " s)");
-    prev_t = rec.t;
-    rec.lla.lat = lat_deg * kDeg;
-    rec.lla.lon = lon_deg * kDeg;
-    out.records.push_back(rec);
+  const int checked = gins ? kCols11 : 4;
+  for (int c = 0; c < checked; ++c)
+    if (!std::isfinite(r[c]))
+      throw InputError(where(file_, i) + "column " + std::to_string(c) + " (" +
+                       (gins ? kNames11[c] : kNames5[c]) + ") is " + num(r[c]) +
+                       "; values must be finite");
+  rec = TruthRecord{};
+  double lat_deg, lon_deg;
+  if (gins) {
+    const double week = r[0];
+    if (week < 0.0 || week != std::floor(week))
+      throw InputError(where(file_, i) + "GPS week " + num(week) +
+                       " is not a non-negative integer (is this an 11-column GINS file?)");
+    if (!started_) first_week_ = week;
+    if (week < first_week_)
+      throw InputError(where(file_, i) + "GPS week " + num(week) +
+                       " is before the first record's week " + num(first_week_));
+    rec.t = r[1] + kWeekSeconds * (week - first_week_);
+    lat_deg = r[2];
+    lon_deg = r[3];
+    rec.lla.h = r[4];
+    rec.v_ned = Vec3(r[5], r[6], r[7]);
+    rec.rpy = Vec3(r[8], r[9], r[10]) * kDeg;
+  } else {
+    rec.t = r[0];
+    lat_deg = r[1];
+    lon_deg = r[2];
+    rec.lla.h = r[3];
   }
+  if (!lat_lon_ok(lat_deg, lon_deg))
+    throw InputError(where(file_, i) + "latitude " + num(lat_deg) + " / longitude " +
+                     num(lon_deg) + " deg out of range (|lat| <= 90, |lon| <= 180)");
+  if (started_ && !(rec.t > prev_t_))
+    throw InputError(where(file_, i) + "time " + num(rec.t) +
+                     " s does not increase (previous record: " + num(prev_t_) + " s)");
+  started_ = true;
+  prev_t_ = rec.t;
+  rec.lla.lat = lat_deg * kDeg;
+  rec.lla.lon = lon_deg * kDeg;
+  return true;
+}
+
+TruthData read_truth(const std::filesystem::path& file, TruthLayout layout) {
+  TruthReader rd(file, layout);
+  TruthData out;
+  out.file = file;
+  out.layout = rd.layout();
+  out.has_velocity_attitude = rd.has_velocity_attitude();
+  out.records.reserve(rd.rows());
+  TruthRecord rec;
+  while (rd.next(rec)) out.records.push_back(rec);
+  out.gps_week = rd.gps_week();
   return out;
 }
 

@@ -33,6 +33,7 @@
 
 namespace wheelins {
 
+class BinaryRowReader;
 class BinaryRowWriter;
 
 /// One reference epoch. Angles in radians, lat/lon in radians (earth::Geodetic).
@@ -58,6 +59,30 @@ struct TruthData {
 /// Decides the layout of `file` by the rule above. Throws InputError naming the
 /// file when it fits neither layout or the content is ambiguous.
 TruthLayout detect_truth_layout(const std::filesystem::path& file);
+
+/// Streams a truth file record by record (constant memory), validating each as
+/// read_truth() does; the same InputError names the file and the record.
+class TruthReader {
+ public:
+  explicit TruthReader(const std::filesystem::path& file, TruthLayout layout = TruthLayout::kAuto);
+  ~TruthReader();
+  TruthReader(const TruthReader&) = delete;
+  TruthReader& operator=(const TruthReader&) = delete;
+  /// The next record; false at the end.
+  bool next(TruthRecord& out);
+  const std::filesystem::path& file() const { return file_; }
+  TruthLayout layout() const { return layout_; }
+  bool has_velocity_attitude() const { return layout_ == TruthLayout::kGins11; }
+  double gps_week() const { return first_week_; }  ///< the first record's week (kGins11)
+  std::uint64_t rows() const;                       ///< records in the file
+
+ private:
+  std::filesystem::path file_;
+  TruthLayout layout_;
+  std::unique_ptr<BinaryRowReader> rows_;
+  double first_week_ = 0.0, prev_t_ = 0.0;
+  bool started_ = false;
+};
 
 /// Reads and validates a truth file. Every record must have finite values (the
 /// unused kPos5 column excepted), strictly increasing time, |lat| <= 90 deg and
