@@ -35,7 +35,6 @@ struct RunArgs {
   std::string formats;
   std::string speed;
   bool centralized = false;
-  bool cross_jacobians = false;
   bool no_constraint = false;
   bool no_faults = false;
   bool no_evaluate = false;
@@ -61,7 +60,6 @@ int run(const RunArgs& a) {
   }
   if (!a.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(a.speed);
   if (a.centralized) cfg.nav.fusion.centralized = true;
-  if (a.cross_jacobians) cfg.nav.fusion.centralized = cfg.nav.fusion.cross_jacobians = true;
   if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
   if (a.force) cfg.overwrite = true;
   if (a.duration > 0) cfg.max_duration = a.duration;
@@ -172,11 +170,7 @@ const bool registered = cli::register_command(
       sub.add_option("--out,-o", a->out, "Output directory");
       sub.add_option("--formats", a->formats, "Trajectory formats: csv,tum,kml (default: all)");
       sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
-      sub.add_flag("--centralized", a->centralized,
-                   "One joint covariance over all IMUs (the paper's centralized filter)");
-      sub.add_flag("--cross-jacobians", a->cross_jacobians,
-                   "Centralized, with each measurement differentiated w.r.t. every IMU's "
-                   "states (instead of the paper's per-IMU models)");
+      sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
       sub.add_flag("--no-evaluate", a->no_evaluate,
                    "Do not evaluate against the manifest's truth (the evaluation streams the truth "

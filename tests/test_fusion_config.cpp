@@ -64,7 +64,7 @@ filter:
   covariance_interval_s: 0.02
   wheel_velocity_std_m_s: [0.05, 0.03, 0.03]
   initial_std: {heading_deg: 0.5}
-fusion: {speed: own, position_update_hz: 2, position_std_m: 0.3, centralized: true, cross_jacobians: true}
+fusion: {speed: own, position_update_hz: 2, position_std_m: 0.3, centralized: true}
 faults: {heading_gate_deg: 8, window: 30, max_failed: 20, probation_s: 5}
 )");
   std::vector<std::string> warnings;
@@ -84,7 +84,6 @@ faults: {heading_gate_deg: 8, window: 30, max_failed: 20, probation_s: 5}
   EXPECT_DOUBLE_EQ(c.nav.fusion.position_update_interval, 0.5);
   EXPECT_DOUBLE_EQ(c.nav.fusion.position_std, 0.3);
   EXPECT_TRUE(c.nav.fusion.centralized);
-  EXPECT_TRUE(c.nav.fusion.cross_jacobians);
   EXPECT_TRUE(c.nav.faults.enabled);
   EXPECT_NEAR(c.nav.faults.heading_gate, 8.0 * kDeg, 1e-15);
   EXPECT_EQ(c.nav.faults.window, 30);

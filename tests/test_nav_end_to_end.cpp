@@ -185,22 +185,18 @@ TEST_F(NavEndToEnd, IdealCentralizedWithMeanWheelSpeedKeepsHeading) {
   // +-yaw rate x track / 2 in a turn. On error-free data the centralized filter turned that
   // into a common heading drift of all IMUs (0.67 deg RMSE triple, 0.76 deg dual, against
   // 0.06 deg distributed) until the error was counted in its measurement noise.
-  // (That is the cross-Jacobian model's; the paper's model is checked here as well.)
   const Manifest m = load_manifest(*ideal_ / "manifest.yaml", {});
-  for (bool cross : {true, false})
   for (const char* config : {"dual-wheel", "triple"}) {
     NavigatorOptions nav;
     nav.fusion.speed = SpeedSharing::kMean;
     nav.fusion.centralized = true;
-    nav.fusion.cross_jacobians = cross;
     const Outcome o = navigate(*ideal_, configuration_modules(m, config, {}), nav);
-    SCOPED_TRACE(std::string(config) + (cross ? " cross-Jacobians" : " paper model"));
+    SCOPED_TRACE(config);
     EXPECT_GT(o.eval.distance, 1100.0);
     EXPECT_LT(o.eval.heading_rmse, 0.25 * kDeg) << o.eval.heading_rmse / kDeg << " deg";
     EXPECT_LT(o.eval.drift_rate, 0.0003) << 100 * o.eval.drift_rate << " %";
-    std::printf("[ measured ] %s centralized (%s), mean speed, ideal: drift %.4f %%, heading RMSE %.3f deg\n",
-                config, cross ? "cross-Jacobians" : "paper model", 100 * o.eval.drift_rate,
-                o.eval.heading_rmse / kDeg);
+    std::printf("[ measured ] %s centralized, mean speed, ideal: drift %.4f %%, heading RMSE %.3f deg\n",
+                config, 100 * o.eval.drift_rate, o.eval.heading_rmse / kDeg);
   }
 }
 
@@ -223,60 +219,6 @@ TEST_F(NavEndToEnd, CentralizedEqualsDistributedWithoutConstraint) {
   EXPECT_NEAR(c.eval.mean_nees, d.eval.mean_nees, 1e-6);
 }
 
-TEST_F(NavEndToEnd, CentralizedPaperModelIsTheDistributedModelOnTheJointState) {
-  // Section VI-B-2: the centralized filter keeps the distributed filter's measurement
-  // models. Its H has the measuring IMU's block only: for the velocity update the block
-  // of the exact (cross-Jacobian) model, for the constraint the full H_i of eq. (12)
-  // (the exact derivative of r_o^i - sum k_j r_o^j has (1 - k_i) H_i there).
-  const Manifest m = load_manifest(*field_ / "manifest.yaml", {});
-  const auto modules = configuration_modules(m, "triple", {});
-  auto make = [&](bool cross) {
-    NavigatorOptions nav;
-    nav.fusion.centralized = true;
-    nav.fusion.cross_jacobians = cross;
-    nav.earth_rotation = m.earth_rotation;
-    auto n = std::make_unique<Navigator>(m, modules, nav, [](int, const TrajectoryRecord&) {});
-    std::vector<std::unique_ptr<ImuStream>> readers;
-    for (const auto& name : modules)
-      readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
-                                                        imu_read_options(*m.find(name))));
-    ImuMerger merger(std::move(readers));
-    std::size_t idx = 0;
-    ImuSample s;
-    // Up to the first update epoch after the static period: both filters still agree.
-    while (merger.next(idx, s) && s.t < m.static_end + 0.49) n->process(static_cast<int>(idx), s);
-    return n;
-  };
-  const auto paper = make(false), exact = make(true);
-  for (int i = 0; i < 3; ++i) {
-    for (int kind = 0; kind < 2; ++kind) {
-      JointMeasurement a, b;
-      if (kind == 0) {
-        paper->velocity_measurement(i, a);
-        exact->velocity_measurement(i, b);
-      } else {
-        paper->position_measurement(i, a);
-        exact->position_measurement(i, b);
-      }
-      // (The Body-INS block of the exact constraint also holds the wheels' level terms,
-      // so the own-block comparison of the constraint is made for the wheels, 0 and 1.)
-      const double own_scale = kind == 0 ? 1.0 : 1.0 / (1.0 - 1.0 / 3.0);
-      if (kind == 0 || i < 2) {
-        EXPECT_LT((a.H[i] - own_scale * b.H[i]).cwiseAbs().maxCoeff(), 1e-9)
-            << (kind ? "position" : "velocity") << " of " << i;
-      }
-      EXPECT_LT((a.dz - b.dz).norm(), 1e-12);
-      for (int j = 0; j < 3; ++j)
-        if (j != i) {
-          EXPECT_TRUE(a.H[j].isZero()) << kind << " " << i << " block " << j;
-          if (kind == 1) {
-            EXPECT_FALSE(b.H[j].isZero());
-          }
-        }
-    }
-  }
-}
-
 TEST_F(NavEndToEnd, CentralizedMeasurementJacobiansMatchFiniteDifference) {
   // The centralized filter's H (Section VI-B-2) against a finite difference of the
   // navigator's own measurement over every IMU's error state: the mean wheel speed depends
@@ -288,7 +230,6 @@ TEST_F(NavEndToEnd, CentralizedMeasurementJacobiansMatchFiniteDifference) {
   for (SpeedSharing speed : {SpeedSharing::kMean, SpeedSharing::kOwn}) {
     NavigatorOptions nav;
     nav.fusion.centralized = true;
-    nav.fusion.cross_jacobians = true;  // the exact dependence on every IMU (not the paper's)
     nav.fusion.speed = speed;
     nav.earth_rotation = m.earth_rotation;
     Navigator navigator(m, modules, nav, [](int, const TrajectoryRecord&) {});

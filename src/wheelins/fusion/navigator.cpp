@@ -24,11 +24,7 @@ std::string NavigatorOptions::describe() const {
     << fusion.position_update_interval << " s, sigma " << fusion.position_std << " m\n"
     << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
     << "filter structure:           "
-    << (fusion.centralized ? (fusion.cross_jacobians
-                                  ? "centralized (one joint covariance, cross-IMU Jacobians)"
-                                  : "centralized (one joint covariance, paper's measurement models)")
-                           : "distributed (paper)")
-    << "\n"
+    << (fusion.centralized ? "centralized (one joint covariance)" : "distributed (paper)") << "\n"
     << "innovation gates (vel/pos): " << wheel.gate << " / " << fusion.position_gate
     << " (0 = off)\n"
     << "initial sigma:              position " << wheel.init.position << " m, velocity "
@@ -298,7 +294,7 @@ void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
     jm.H[i] = m.H;
     add_level_block(m.H_level, 1.0, jm.H);
     jm.dz = m.innovation();
-    if (mean && opt_.fusion.cross_jacobians) {
+    if (mean) {
       // The mean of the wheel speeds is the speed of the mean of the wheel centres (o for a
       // left/right pair), not of this wheel's centre, which eq. (5) predicts: in a turn it is
       // off by yaw rate x (offset of this wheel from that point), +-omega_z track / 2, up to
@@ -338,16 +334,6 @@ void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
       jm.H[j](0, BG) -= ds.dbgx / n_mean;
       jm.H[j](0, SG) -= ds.dsgx / n_mean;
     }
-  if (!opt_.fusion.cross_jacobians) keep_own_block(i, jm);
-}
-
-void Navigator::keep_own_block(int i, JointMeasurement& jm) const {
-  // The paper's centralized filter (Section VI-B-2): "the measurement model built in the
-  // centralized filter was the same as that in the proposed distributed filter", i.e. each
-  // measurement on its own IMU's error states only; the joint covariance carries the
-  // correlations through the update.
-  for (int j = 0; j < kMaxCentralized; ++j)
-    if (j != i) jm.H[j].setZero();
 }
 
 bool Navigator::reference_weights(std::array<double, kMaxModules>& k, int& n_ref,
@@ -390,9 +376,7 @@ void Navigator::position_measurement(int i, const std::array<double, kMaxModules
   Vec3 fused = Vec3::Zero(), own = Vec3::Zero();
   for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
   for (int j = 0; j < N; ++j) {
-    // The exact derivative of dz_i has (1 - k_i) in block i and -k_j elsewhere; the paper's
-    // model (eq. 12, cross_jacobians off) takes the reference as given: 1 in block i only.
-    const double c = opt_.fusion.cross_jacobians ? (j == i ? 1.0 : 0.0) - k[j] : (j == i ? 1.0 : 0.0);
+    const double c = (j == i ? 1.0 : 0.0) - k[j];
     if (c == 0.0 && k[j] == 0.0) continue;  // neither this module nor in the reference
     ReferencePointInput in = subs_[j]->reference_point_input();
     if (shared && in.wheel) {
@@ -401,12 +385,11 @@ void Navigator::position_measurement(int i, const std::array<double, kMaxModules
     }
     const ReferencePointModel m = reference_point_model(in);
     jm.H[j] += c * m.H;
-    if (in.wheel && c != 0.0) add_level_block(m.H_level, c, jm.H);
+    if (in.wheel) add_level_block(m.H_level, c, jm.H);
     fused += k[j] * m.r_o;
     if (j == i) own = m.r_o;
   }
   jm.dz = own - fused;
-  if (!opt_.fusion.cross_jacobians) keep_own_block(i, jm);
   const double sd = opt_.fusion.position_std;
   jm.R = Mat3::Identity() * sd * sd;
   jm.gate = opt_.fusion.position_gate;

@@ -41,13 +41,6 @@ struct FusionOptions {
   std::vector<double> weights;            ///< k_i of eq. (9); empty = equal
   /// One joint covariance over all IMUs (Section VI-B-2) instead of one per subsystem.
   bool centralized = false;
-  /// Centralized filter only. Off (the paper's centralized filter, Section VI-B-2): every
-  /// measurement keeps the distributed filter's model, on its own IMU's error states, and the
-  /// joint covariance carries the correlations. On: each measurement's H also holds its
-  /// exact dependence on the other IMUs' states (the mean wheel speed on their gyro-x
-  /// errors, the shared level on the Body-INS attitude, the reference point of eq. 9 on
-  /// every IMU in it), with the left/right speed difference in turns counted as noise.
-  bool cross_jacobians = false;
 };
 
 struct NavigatorOptions {
@@ -167,8 +160,6 @@ class Navigator {
                        std::array<H3, kMaxCentralized>& h) const;
   /// Fuses a joint measurement into the joint covariance and feeds every subsystem back.
   UpdateReport fuse_joint(const JointMeasurement& m);
-  /// Zeroes every block of jm.H but subsystem i's (the paper's centralized model).
-  void keep_own_block(int i, JointMeasurement& jm) const;
   /// Moves subsystem i's accumulated dynamics into the joint covariance.
   void propagate_joint(int i);
   /// Every covariance (own or joint) propagated to the current epoch.

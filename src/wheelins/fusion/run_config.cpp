@@ -121,8 +121,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   if (auto f = y.get(root, "fusion"); f.IsDefined()) {
     y.require_map(f, "fusion");
     y.check_keys(f, "fusion", {"speed", "share_level", "position_constraint", "position_update_hz",
-                               "position_std_m", "position_gate", "weights", "centralized",
-                               "cross_jacobians"});
+                               "position_std_m", "position_gate", "weights", "centralized"});
     FusionOptions& o = c.nav.fusion;
     if (auto v = y.get(f, "speed"); v.IsDefined())
       o.speed = y.choice<SpeedSharing>(v, "fusion.speed",
@@ -145,8 +144,6 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     }
     if (auto v = y.get(f, "weights"); v.IsDefined()) o.weights = y.number_list(v, "fusion.weights");
     if (auto v = y.get(f, "centralized"); v.IsDefined()) o.centralized = y.boolean(v, "fusion.centralized");
-    if (auto v = y.get(f, "cross_jacobians"); v.IsDefined())
-      o.cross_jacobians = y.boolean(v, "fusion.cross_jacobians");
   }
 
   if (auto f = y.get(root, "faults"); f.IsDefined()) {
