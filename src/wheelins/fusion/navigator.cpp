@@ -157,7 +157,9 @@ void Navigator::process(int index, const ImuSample& raw) {
   const double t_all = min_time();
   using Clock = std::chrono::steady_clock;
   if (t_all + 1e-9 >= next_velocity_t_) {
-    flush_covariances();  // the time update is not the velocity step's cost (Table 8)
+    // Every P brought to this epoch before a measurement uses it; outside the timed step,
+    // since the time update is not the velocity step's cost (Table 8).
+    flush_covariances();
     const auto t0 = Clock::now();
     velocity_updates();
     check_covariances();
@@ -443,7 +445,6 @@ void Navigator::count_velocity_update(int i, const UpdateReport& rep, double t_n
 }
 
 void Navigator::velocity_updates() {
-  flush_covariances();  // every P at this epoch before any measurement uses it
   const bool handle = opt_.faults.enabled;
   const double t_now = min_time();
   if (handle) fault_housekeeping(t_now);
@@ -570,7 +571,6 @@ Mat21 Navigator::covariance(int i) const {
 }
 
 void Navigator::position_update() {
-  flush_covariances();
   // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 9) is the
   // reference; modules on probation are tied to it without moving it.
   const int n = subsystem_count();

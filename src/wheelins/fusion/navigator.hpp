@@ -142,7 +142,8 @@ class Navigator {
     int n_mean = 0;
   };
   /// Velocity updates of every module in use; in the centralized filter H also carries the
-  /// other IMUs' blocks (velocity_measurement()).
+  /// other IMUs' blocks (velocity_measurement()). Like position_update(), it expects every
+  /// covariance at the current epoch (process() calls flush_covariances() first).
   void velocity_updates();
   void count_velocity_update(int i, const UpdateReport& rep, double t_now);
   /// The Body-INS level is shared: sharing on and the Body-INS counted.
