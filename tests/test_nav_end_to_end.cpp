@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "wheelins/eval/metrics.hpp"
@@ -25,6 +26,19 @@ fs::path scratch(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("wheelins-e2e-" + name + "-" + std::to_string(rd()));
   fs::create_directories(p);
   return p;
+}
+
+// Feeds `modules`' samples (merged by time) to `navigator` while their time is below t_end.
+void replay(Navigator& navigator, const Manifest& m, const std::vector<std::string>& modules,
+            double t_end = std::numeric_limits<double>::infinity()) {
+  std::vector<std::unique_ptr<ImuStream>> readers;
+  for (const auto& name : modules)
+    readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
+                                                      imu_read_options(*m.find(name))));
+  ImuMerger merger(std::move(readers));
+  std::size_t i = 0;
+  ImuSample s;
+  while (merger.next(i, s) && s.t < t_end) navigator.process(static_cast<int>(i), s);
 }
 
 struct Outcome {
@@ -136,14 +150,7 @@ TEST_F(NavEndToEnd, CovariancesStaySymmetricPositiveDefinite) {
     nav.earth_rotation = m.earth_rotation;
     const auto modules = configuration_modules(m, "triple", {});
     Navigator navigator(m, modules, nav, [](int, const TrajectoryRecord&) {});
-    std::vector<std::unique_ptr<ImuStream>> readers;
-    for (const auto& name : modules)
-      readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
-                                                        imu_read_options(*m.find(name))));
-    ImuMerger merger(std::move(readers));
-    std::size_t i = 0;
-    ImuSample s;
-    while (merger.next(i, s)) navigator.process(static_cast<int>(i), s);
+    replay(navigator, m, modules);
     for (int k = 0; k < navigator.subsystem_count(); ++k) {
       const TrajectoryRecord r = navigator.vehicle_record();
       EXPECT_TRUE(r.p_std.allFinite());
@@ -233,15 +240,7 @@ TEST_F(NavEndToEnd, CentralizedMeasurementJacobiansMatchFiniteDifference) {
     nav.fusion.speed = speed;
     nav.earth_rotation = m.earth_rotation;
     Navigator navigator(m, modules, nav, [](int, const TrajectoryRecord&) {});
-    std::vector<std::unique_ptr<ImuStream>> readers;
-    for (const auto& name : modules)
-      readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
-                                                        imu_read_options(*m.find(name))));
-    ImuMerger merger(std::move(readers));
-    std::size_t idx = 0;
-    ImuSample s;
-    while (merger.next(idx, s) && s.t < m.static_end + 47.3)  // moving, in a turn
-      navigator.process(static_cast<int>(idx), s);
+    replay(navigator, m, modules, m.static_end + 47.3);  // moving, in a turn
     const int N = navigator.subsystem_count();
     ASSERT_EQ(N, 3);
     const double eps = 1e-6;
