@@ -298,7 +298,9 @@ TEST(EvalMetrics, LatLonTrajectoryUsesFrameAndErrorsWithoutOverlap) {
 TEST(EvalMetrics, StreamingEvaluatorKeepsConstantMemoryAndMatchesEvaluate) {
   // 2000 s of a 200 Hz truth against a 20 Hz trajectory with a growing error, fed in step
   // as `wheelins run` does: the evaluator never holds more than the truth records between
-  // two trajectory records, and its result is evaluate()'s.
+  // two trajectory records, and its result is evaluate()'s (evaluate() is built on the
+  // Evaluator, so its streamed drift curve and heading RMSE are also checked against the
+  // batch drift_rate_curve() and an RMS taken from the per-epoch series).
   const earth::LocalFrame frame(kOrigin);
   auto pos = [](double t) { return Vec3(1.2 * t, 30.0 * std::sin(0.01 * t), 0.0); };
   auto err = [](double t) { return Vec3(0.001 * t, -0.0005 * t, 0.0); };
@@ -333,4 +335,16 @@ TEST(EvalMetrics, StreamingEvaluatorKeepsConstantMemoryAndMatchesEvaluate) {
   EXPECT_NEAR(s.heading_rmse, 0.002, 1e-9);
   EXPECT_DOUBLE_EQ(s.max_error, batch.max_error);
   EXPECT_GT(s.drift_rate, 0.0);
+  std::vector<double> dist, err_h;
+  double sum_h2 = 0.0;
+  for (const EpochError& e : batch.series) {
+    dist.push_back(e.distance);
+    err_h.push_back(e.err_h);
+    sum_h2 += e.heading_err * e.heading_err;
+  }
+  const std::vector<double> curve = drift_rate_curve(dist, err_h, 100.0);
+  ASSERT_EQ(s.drift_curve.size(), curve.size());
+  ASSERT_GT(curve.size(), 10u);
+  for (std::size_t k = 0; k < curve.size(); ++k) EXPECT_DOUBLE_EQ(s.drift_curve[k], curve[k]) << k;
+  EXPECT_NEAR(s.heading_rmse, std::sqrt(sum_h2 / static_cast<double>(batch.series.size())), 1e-15);
 }
