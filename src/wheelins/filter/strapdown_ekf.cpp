@@ -10,6 +10,9 @@ void StrapdownEkf::initialize(const NavState& state, const ImuErrors& errors,
   noise_ = noise;
   mech_ = mech;
   have_last_ = false;
+  // The constant blocks of F (earth rate, Gauss-Markov decays) once; the others accumulate.
+  pending_ = error_dynamics_blocks(Mat3::Identity(), Vec3::Zero(), Vec3::Zero(),
+                                   mech.omega_ie_inW, noise);
   clear_pending();
   P_.setZero();
   P_.block<3, 3>(P, P).diagonal().setConstant(init.position * init.position);
@@ -31,13 +34,6 @@ void StrapdownEkf::propagate_nominal(const ImuSample& raw) {
   have_last_ = true;
   const ErrorDynamics d = error_dynamics_blocks(state_.C_ItoW(), cur.dtheta / cur.dt,
                                                 cur.dvel / cur.dt, mech_.omega_ie_inW, noise_);
-  if (pending_dt_ == 0.0) {
-    pending_.W = d.W;
-    pending_.decay_bg = d.decay_bg;
-    pending_.decay_ba = d.decay_ba;
-    pending_.decay_sg = d.decay_sg;
-    pending_.decay_sa = d.decay_sa;
-  }
   pending_.Ff += cur.dt * d.Ff;
   pending_.C += cur.dt * d.C;
   pending_.Cf += cur.dt * d.Cf;

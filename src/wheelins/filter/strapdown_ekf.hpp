@@ -39,10 +39,10 @@ class StrapdownEkf {
   void propagate_nominal(const ImuSample& raw);
 
   /// Covariance time update at a lower rate than the mechanization: the blocks of F are
-  /// integrated over the epochs of `interval` seconds and P is propagated once with
-  /// Phi = I + (integral of F dt) (eq. 2 discretized over the interval; exact to first
-  /// order in the interval, and C_b^w of a spinning wheel is integrated, not sampled).
-  /// 0 = every epoch. Every measurement update first propagates P to the current epoch.
+  /// integrated over the epochs of `interval` seconds and P is propagated once with their
+  /// mean F in Phi = I + F T + (F T)^2 / 2 (eq. 2 discretized over the interval T; C_b^w of
+  /// a spinning wheel is integrated, not sampled). 0 = every epoch. Every measurement
+  /// update first propagates P to the current epoch.
   void set_covariance_interval(double interval) { covariance_interval_ = interval; }
   double covariance_interval() const { return covariance_interval_; }
   /// The accumulated dynamics are due for a covariance propagation.
@@ -69,13 +69,10 @@ class StrapdownEkf {
 
   const NavState& state() const { return state_; }
   const ImuErrors& errors() const { return errors_; }
-  /// P as of the last covariance propagation (at most covariance_interval() old; the
-  /// non-const accessor propagates it to the current epoch first).
+  /// P as of the last covariance propagation (at most covariance_interval() old; call
+  /// flush_covariance() first for P at the current epoch). Read-only: an accessor that
+  /// propagated P as a side effect made every read through a non-const path a time update.
   const Mat21& covariance() const { return P_; }
-  Mat21& covariance() {
-    flush_covariance();
-    return P_;
-  }
   /// The last sample compensated with the current error estimates, as rates [rad/s],
   /// [m/s^2] (after a feedback, the corrected estimates apply: measurement models evaluated
   /// between two epochs, e.g. a centralized filter's sequential updates, stay consistent).

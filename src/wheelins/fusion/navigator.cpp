@@ -564,10 +564,7 @@ UpdateReport Navigator::fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, 
 }
 
 Mat21 Navigator::covariance(int i) const {
-  // (subs_ holds unique_ptrs, whose -> gives a non-const Subsystem even here: the const
-  // accessor must be asked for, or every read would propagate P.)
-  const Subsystem& s = *subs_[i];
-  return joint_ ? joint_->block(i) : s.ekf().covariance();
+  return joint_ ? joint_->block(i) : subs_[i]->ekf().covariance();
 }
 
 void Navigator::position_update() {
