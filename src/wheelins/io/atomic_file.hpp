@@ -18,7 +18,7 @@ void check_output_target(const std::filesystem::path& file, bool overwrite);
 void append_double(std::string& out, double value, int significant = 0);
 /// The same into `dst`, which must have room for kMaxDoubleChars; returns the end.
 constexpr int kMaxDoubleChars = 32;
-char* format_double(char* dst, double value, int significant = 0);
+char* write_double(char* dst, double value, int significant = 0);
 /// Appends `value` with a fixed number of decimals (e.g. degrees in KML).
 void append_fixed(std::string& out, double value, int decimals);
 

@@ -125,7 +125,7 @@ class CsvWriter final : public TrajectoryWriter {
     char line[kMaxCsvColumns * (kMaxDoubleChars + 1)];
     char* p = line;
     for (const auto& c : csv_columns()) {
-      p = format_double(p, c.get(rec), c.full_precision ? 0 : kStdDigits);
+      p = write_double(p, c.get(rec), c.full_precision ? 0 : kStdDigits);
       *p++ = ',';
     }
     if (p == line) *p++ = '\n';  // (no columns: cannot happen)
