@@ -77,7 +77,10 @@ int run(const RunArgs& a) {
   std::unique_ptr<eval::Evaluator> evaluator;
   TruthRecord next_truth;
   bool have_next_truth = false;
-  std::string eval_error;  // a bad truth record: reported after the trajectory is written
+  // A truth file that cannot be opened, or whose first record is bad, stops the command
+  // before the run (nothing written yet); a bad record met later is reported after the
+  // trajectory is written (eval_error).
+  std::string eval_error;
   if (evaluate) {
     truth = std::make_unique<TruthReader>(req.manifest.resolve(*req.manifest.truth_file));
     eval::Evaluator::Sources src;
@@ -119,7 +122,7 @@ int run(const RunArgs& a) {
               nav_s, static_cast<unsigned long long>(st.epochs), res.wall_seconds,
               1e6 * res.wall_seconds / std::max<double>(1.0, static_cast<double>(st.epochs)),
               nav_s / std::max(1e-9, res.wall_seconds));
-  std::printf("navigator incl. output records, excl. input reading and file writing (second thread): %.2f us per epoch\n",
+  std::printf("navigator incl. output records, excl. input reading, evaluation and file writing: %.2f us per epoch\n",
               1e6 * res.filter_seconds / std::max<double>(1.0, static_cast<double>(st.epochs)));
   std::printf("velocity updates: %llu (%llu rejected, max test ratio %.2f)\n",
               static_cast<unsigned long long>(st.velocity_updates),
@@ -137,6 +140,7 @@ int run(const RunArgs& a) {
   if (evaluate) {
     if (eval_error.empty()) {
       try {
+        evaluator->end_trajectory();
         feed_truth_before(std::numeric_limits<double>::infinity());
       } catch (const InputError& e) {
         eval_error = e.what();

@@ -322,8 +322,24 @@ TEST(EvalMetrics, StreamingEvaluatorKeepsConstantMemoryAndMatchesEvaluate) {
     ev.add_trajectory(r);
     max_pending = std::max(max_pending, ev.pending());
   }
-  while (i < truth.records.size()) ev.add_truth(truth.records[i++]);
+  ev.end_trajectory();  // the last second of truth is then not held back
+  while (i < truth.records.size()) {
+    ev.add_truth(truth.records[i++]);
+    max_pending = std::max(max_pending, ev.pending());
+  }
   const EvalResult s = ev.finish();
+  {
+    // A trajectory going back in time is an error naming the source and the record.
+    Evaluator back(frame, src, {}, false);
+    back.add_trajectory(traj.records[1]);
+    try {
+      back.add_trajectory(traj.records[0]);
+      ADD_FAILURE() << "a backwards time was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("traj.csv"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("record 1"), std::string::npos) << e.what();
+    }
+  }
   EXPECT_LE(max_pending, 11u);  // 0.05 s of 200 Hz truth
   EXPECT_TRUE(s.series.empty());
   EXPECT_EQ(s.epochs, batch.epochs);

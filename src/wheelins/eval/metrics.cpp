@@ -60,6 +60,7 @@ struct Evaluator::State {
 
   Sample a, b;          // the last two trajectory samples (b the latest)
   std::size_t n_traj = 0;
+  bool traj_ended = false;  // end_trajectory() was called
   double first_traj_t = 0.0;
   std::deque<Truth> pending;
   bool have_truth = false;
@@ -200,8 +201,9 @@ Evaluator::Evaluator(const earth::LocalFrame& frame, const Sources& sources,
 
 Evaluator::~Evaluator() = default;
 
-double Evaluator::trajectory_time() const {
-  return s_->n_traj ? s_->b.t : -std::numeric_limits<double>::infinity();
+void Evaluator::end_trajectory() {
+  s_->traj_ended = true;
+  s_->drain(true);
 }
 
 std::size_t Evaluator::pending() const { return s_->pending.size(); }
@@ -223,11 +225,17 @@ void Evaluator::add_truth(const TruthRecord& r) {
   if (s.n_traj >= 2 && x.t < s.a.t && x.t >= s.first_traj_t - kTimeSlack)
     throw std::logic_error("Evaluator: a truth record came after the trajectory had passed it");
   s.pending.push_back(x);
-  s.drain(false);
+  s.drain(s.traj_ended);
 }
 
 void Evaluator::add_trajectory(const TrajectoryRecord& r) {
   State& s = *s_;
+  if (s.traj_ended) throw std::logic_error("Evaluator: a trajectory record after end_trajectory()");
+  if (!std::isfinite(r.t) || (s.n_traj > 0 && !(r.t > s.b.t)))
+    throw InputError(quote(s.res.traj_file) + ": record " + std::to_string(s.n_traj) +
+                     " (0-based): time " + std::to_string(r.t) +
+                     (s.n_traj > 0 ? " is not after the previous record's " + std::to_string(s.b.t)
+                                   : std::string(" is not a finite number")));
   State::Sample k;
   k.t = r.t;
   k.p = s.src.traj_has_lla ? s.frame.ned_from_geodetic(r.lla) : r.p_inN;
@@ -313,6 +321,7 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
     while (i < truth.records.size() && truth.records[i].t < r.t) ev.add_truth(truth.records[i++]);
     ev.add_trajectory(r);
   }
+  ev.end_trajectory();
   while (i < truth.records.size()) ev.add_truth(truth.records[i++]);
   return ev.finish();
 }

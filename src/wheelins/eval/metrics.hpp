@@ -117,8 +117,10 @@ class Evaluator {
 
   void add_truth(const TruthRecord& r);
   void add_trajectory(const TrajectoryRecord& r);
-  /// Time of the latest trajectory record (-inf before the first).
-  double trajectory_time() const;
+  /// No trajectory records follow: the truth records still to come are evaluated (or
+  /// counted as outside) as they arrive instead of waiting, so feeding the rest of a long
+  /// truth file keeps memory flat.
+  void end_trajectory();
   /// Truth records waiting for the trajectory to reach them.
   std::size_t pending() const;
   /// The result; InputError (naming the files) when no truth epoch fell inside the
