@@ -32,7 +32,7 @@ struct RunRequest {
 struct RunResult {
   NavigatorStats stats;
   double wall_seconds = 0.0;
-  double filter_seconds = 0.0;  ///< time inside the navigator incl. making the records (no input reading; text formatting and writing run on a second thread)
+  double filter_seconds = 0.0;  ///< time inside the navigator incl. making the records (no input reading, no on_record, no hand-over to the writer thread)
   std::vector<std::filesystem::path> files;  ///< what was written
   std::string fault_report;                  ///< readable summary of the fault handling
   std::vector<FaultEvent> fault_events;      ///< every detection and what was done
