@@ -32,12 +32,14 @@ void StrapdownEkf::propagate_nominal(const ImuSample& raw) {
   last_ = cur;
   last_raw_ = raw;
   have_last_ = true;
-  const ErrorDynamics d = error_dynamics_blocks(state_.C_ItoW(), cur.dtheta / cur.dt,
-                                                cur.dvel / cur.dt, mech_.omega_ie_inW, noise_);
-  pending_.Ff += cur.dt * d.Ff;
-  pending_.C += cur.dt * d.C;
-  pending_.Cf += cur.dt * d.Cf;
-  pending_.Cw += cur.dt * d.Cw;
+  // The epoch's varying blocks of F (error_dynamics_blocks) times dt, taken straight from
+  // the increments: [f x] dt = [C dvel x], C diag(f) dt = C diag(dvel), C diag(w) dt =
+  // C diag(dtheta). The constant blocks were set at initialize().
+  const Mat3 C = state_.C_ItoW();
+  pending_.Ff += skew(C * cur.dvel);
+  pending_.C += cur.dt * C;
+  pending_.Cf += C * cur.dvel.asDiagonal();
+  pending_.Cw += C * cur.dtheta.asDiagonal();
   pending_dt_ += cur.dt;
 }
 

@@ -41,7 +41,8 @@ class StrapdownEkf {
   /// Covariance time update at a lower rate than the mechanization: the blocks of F are
   /// integrated over the epochs of `interval` seconds and P is propagated once with their
   /// mean F in Phi = I + F T + (F T)^2 / 2 (eq. 2 discretized over the interval T; C_b^w of
-  /// a spinning wheel is integrated, not sampled). 0 = every epoch. Every measurement
+  /// a spinning wheel is integrated, not sampled; see apply_transition for the order).
+  /// 0 = every epoch. Every measurement
   /// update first propagates P to the current epoch.
   void set_covariance_interval(double interval) { covariance_interval_ = interval; }
   double covariance_interval() const { return covariance_interval_; }
