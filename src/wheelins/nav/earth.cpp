@@ -23,7 +23,7 @@ Vec3 ecef_from_geodetic(const Geodetic& g) {
 Geodetic geodetic_from_ecef(const Vec3& r) {
   // Bowring's closed form (parametric latitude as the start), then one step of the
   // fixed-point latitude iteration: below 1e-13 rad and 1e-6 m for heights within
-  // +-100 km (tests/test_earth.cpp checks it against ecef_from_geodetic).
+  // +-100 km (Earth.GeodeticFromEcefInvertsEcefFromGeodetic in tests/test_rotation.cpp).
   const double b = kA * std::sqrt(1.0 - kE2);
   const double ep2 = kE2 / (1.0 - kE2);  // second eccentricity squared
   const double p = std::hypot(r.x(), r.y());
@@ -32,11 +32,11 @@ Geodetic geodetic_from_ecef(const Vec3& r) {
   const double beta = std::atan2(r.z() * kA, p * b);
   const double sb = std::sin(beta), cb = std::cos(beta);
   double lat = std::atan2(r.z() + ep2 * b * sb * sb * sb, p - kE2 * kA * cb * cb * cb);
-  double sl = std::sin(lat), cl = std::cos(lat);
+  double sl = std::sin(lat);
   double n = kA / std::sqrt(1.0 - kE2 * sl * sl);
   lat = std::atan2(r.z() + kE2 * n * sl, p);
   sl = std::sin(lat);
-  cl = std::cos(lat);
+  const double cl = std::cos(lat);
   n = kA / std::sqrt(1.0 - kE2 * sl * sl);
   g.lat = lat;
   // Well conditioned at every latitude (no division by cos(lat)).
