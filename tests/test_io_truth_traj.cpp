@@ -233,6 +233,15 @@ TEST(IoTruth, RejectsBadInputNamingFileAndRecord) {
   expect_input_error([&] { read_truth(lon_file, TruthLayout::kPos5); },
                      {"lon.bin", "record 0", "out of range"});
 
+  // An 11-column file cut to a whole number of 40-byte rows: named as truncated, not read
+  // as 5-column rows with a "latitude" of 2200.
+  const auto cut = dir / "cut.bin";
+  std::vector<std::vector<double>> rows;
+  for (int i = 0; i < 100; ++i) rows.push_back({2200, 100.0 + i, 30, 114, 20, 0, 0, 0, 0, 0, 0});
+  write_rows(cut, 11, rows);
+  std::filesystem::resize_file(cut, 8760);  // 8760 = 219 x 40, not a multiple of 88
+  expect_input_error([&] { read_truth(cut); }, {"cut.bin", "8760", "truncated or misaligned"});
+
   const auto odd = dir / "odd.bin";
   spit(odd, std::string(17, 'x'));
   expect_input_error([&] { read_truth(odd); }, {"odd.bin", "fits neither"});

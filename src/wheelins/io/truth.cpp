@@ -95,8 +95,19 @@ TruthLayout detect_truth_layout(const std::filesystem::path& file) {
                      " bytes fits neither truth layout (11 float64 = 88 bytes per record: "
                      "gps_week, t, lat, lon, h, vn, ve, vd, roll, pitch, yaw; or 5 float64 = "
                      "40 bytes: t, lat, lon, h, unused); truncated or not a truth file");
-  if (fits11 && !fits5) return TruthLayout::kGins11;
-  if (fits5 && !fits11) return TruthLayout::kPos5;
+  // One layout fits the size: the content must fit it too, or the file is most likely the
+  // other layout cut short (a truncated GINS.bin can be a whole number of 40-byte rows).
+  auto only = [&](int cols, TruthLayout layout, int other_cols) {
+    if (plausible(file, cols)) return layout;
+    throw InputError(quote(file) + ": size " + std::to_string(bytes) + " bytes fits only the " +
+                     std::to_string(cols) + "-column truth layout (" + std::to_string(8 * cols) +
+                     " bytes per record), but its first records are not such a truth file; " +
+                     (other_cols == kCols11 ? "an " : "a ") +
+                     std::to_string(other_cols) + "-column file (" + std::to_string(8 * other_cols) +
+                     " bytes per record) of this size would be truncated or misaligned");
+  };
+  if (fits11 && !fits5) return only(kCols11, TruthLayout::kGins11, kCols5);
+  if (fits5 && !fits11) return only(kCols5, TruthLayout::kPos5, kCols11);
   const bool ok11 = plausible(file, kCols11);
   const bool ok5 = plausible(file, kCols5);
   if (ok11 && !ok5) return TruthLayout::kGins11;
