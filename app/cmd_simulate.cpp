@@ -9,6 +9,7 @@
 
 #include "cli.hpp"
 #include "wheelins/nav/types.hpp"
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/sim/simulator.hpp"
 
 namespace {
@@ -25,7 +26,7 @@ struct Options {
   bool quiet = false;
   std::vector<std::string> disable, only, settings, faults;
   std::string config;
-  std::optional<double> radius, track, rate, terrain, static_s, speed;
+  std::optional<double> radius, track, rate, terrain, static_s, speed, wheel_noise;
   std::optional<int> laps, chips;
   bool no_earth_rotation = false;
   bool no_ideal = false;
@@ -75,6 +76,10 @@ int run(const Options& o) {
   if (o.static_s) cfg.static_duration = *o.static_s;
   if (o.no_earth_rotation) cfg.earth_rotation = false;
   if (o.no_ideal) cfg.write_ideal = false;
+  if (o.wheel_noise) {
+    cfg.apply_setting("errors.wheel_accel_noise_m_s_sqrt_h=" + wheelins::io_detail::format_double(*o.wheel_noise));
+    cfg.effects.insert("wheel_noise");
+  }
   for (const auto& f : o.faults) cfg.faults.push_back(sim::parse_fault_spec(f));  // after --config's
   if (!o.only.empty()) cfg.only(split_commas(o.only));
   cfg.disable(split_commas(o.disable));
@@ -131,6 +136,9 @@ const bool registered = wheelins::cli::register_command(
       sub.add_option("--cruise-speed", o->speed, "cruise speed [m/s] (default scenario / path without odo)");
       sub.add_option("--terrain", o->terrain, "smooth terrain with slopes up to this many degrees (0: flat)");
       sub.add_option("--static", o->static_s, "static period at the start [s] (default 30)");
+      sub.add_option("--wheel-noise", o->wheel_noise,
+                     "white noise on the Wheel-IMU accelerometers from rolling [m/s/sqrt(h)] at the "
+                     "cruise speed (effect wheel_noise; none at rest unless errors.wheel_accel_noise_rest)");
       sub.add_flag("--no-earth-rotation", o->no_earth_rotation, "data without the earth rotation rate");
       sub.add_flag("--no-ideal", o->no_ideal,
                    "skip the error-free streams (ideal/, manifest-ideal.yaml): half the disk");

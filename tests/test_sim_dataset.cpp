@@ -146,6 +146,8 @@ TEST(SimDataset, WrittenIdealStreamEqualsLibrarySamples) {
 TEST(SimDataset, EveryEffectSwitchChangesTheData) {
   SimConfig base = short_config();
   base.errors.gyro_range = 500.0 * kDeg;  // the wheels turn at ~800 deg/s: saturation acts
+  ASSERT_EQ(base.effects.size(), kFieldEffects);
+  base.effects.insert("wheel_noise");  // in no profile
   ASSERT_EQ(base.effects.size(), all_effects().size());
   const auto full = simulate(base, "eff_full");
   const std::set<std::string> motion = {"vibration", "slip", "skid", "radius"};
@@ -166,6 +168,49 @@ TEST(SimDataset, EveryEffectSwitchChangesTheData) {
     }
     EXPECT_EQ(truth, e == "skid") << e << ": truth";
     EXPECT_TRUE(full.at("scenario.yaml") != v.at("scenario.yaml")) << e;
+  }
+}
+
+// wheel_noise: white noise on the Wheel-IMU accelerometers only, of the stated density at
+// the cruise speed and none at rest (or the stated fraction), in no profile.
+TEST(SimDataset, WheelNoiseHasItsDensityInMotionAndFollowsTheSpeed) {
+  EXPECT_EQ(profile_effects("field").count("wheel_noise"), 0u);
+  SimConfig cfg = short_config();
+  cfg.chips = 1;
+  cfg.only({"wheel_noise"});
+  cfg.apply_setting("errors.wheel_accel_noise_m_s_sqrt_h=2.0");
+  for (double rest : {0.0, 0.5}) {
+    cfg.errors.wheel_accel_noise_rest = rest;
+    const fs::path dir = temp_dir("wheel_noise");
+    const Simulation sim(cfg);
+    sim.write(dir, false, false);
+    BinaryRowReader chip(dir / "left-wheel-imu" / "tri_C1_imu.bin", 7);
+    BinaryRowReader ideal(dir / "ideal" / "left-wheel_imu.bin", 7);
+    BinaryRowReader body(dir / "body-imu" / "tri_C1_imu.bin", 7);
+    BinaryRowReader body_ideal(dir / "ideal" / "body_imu.bin", 7);
+    const double *a, *b, *c, *d;
+    double sum_rest = 0.0, sum_cruise = 0.0, body_diff = 0.0;
+    int n_rest = 0, n_cruise = 0;
+    while ((a = chip.next()) && (b = ideal.next()) && (c = body.next()) && (d = body_ideal.next())) {
+      const double speed = sim.scenario().state(a[0]).v_inN.norm();
+      for (int i = 1; i <= 3; ++i) EXPECT_EQ(a[i], b[i]);  // gyros untouched
+      for (int i = 4; i <= 6; ++i) {
+        const double e = a[i] - b[i];
+        if (speed < 1e-6) sum_rest += e * e, ++n_rest;
+        if (std::abs(speed - 1.4) < 0.02) sum_cruise += e * e, ++n_cruise;
+      }
+      for (int i = 1; i <= 6; ++i) body_diff = std::max(body_diff, std::abs(c[i] - d[i]));
+    }
+    fs::remove_all(dir);
+    ASSERT_GT(n_rest, 300);
+    ASSERT_GT(n_cruise, 1000);
+    const double expected = 2.0 / 60.0 * std::sqrt(200.0);  // per-sample sigma at cruise speed
+    const double at_cruise = std::sqrt(sum_cruise / n_cruise), at_rest = std::sqrt(sum_rest / n_rest);
+    std::printf("[ measured ] rest fraction %.1f: per-sample sigma %.4f m/s^2 at 1.4 m/s (expected ~%.4f), "
+                "%.4f at rest\n", rest, at_cruise, expected, at_rest);
+    EXPECT_NEAR(at_cruise, expected, 0.05 * expected);
+    EXPECT_NEAR(at_rest, rest * expected, 0.08 * expected);
+    EXPECT_EQ(body_diff, 0.0);
   }
 }
 

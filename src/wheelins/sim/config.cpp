@@ -97,6 +97,8 @@ const ErrorKey kErrorKeys[] = {
     {"slip_per_m_s2", &ErrorParams::slip_coeff, kSi},
     {"skid_s", &ErrorParams::skid_coeff, kSi},
     {"time_offset_s", &ErrorParams::time_offset, kSi},
+    {"wheel_accel_noise_m_s_sqrt_h", &ErrorParams::wheel_accel_noise, kVrw},
+    {"wheel_accel_noise_rest", &ErrorParams::wheel_accel_noise_rest, kSi},
     {"calibration_lever_arm_m", &ErrorParams::cal_lever_arm, kSi},
     {"calibration_mounting_deg", &ErrorParams::cal_mounting, kDegU},
     {"calibration_position_m", &ErrorParams::cal_position, kSi},
@@ -128,7 +130,7 @@ std::set<std::string> profile_effects(const std::string& profile) {
   const auto& all = all_effects();
   if (profile == "ideal") return {};
   if (profile == "datasheet") return {all.begin(), all.begin() + 11};
-  if (profile == "field") return {all.begin(), all.end()};
+  if (profile == "field") return {all.begin(), all.begin() + kFieldEffects};
   throw InputError("unknown profile '" + profile + "' (expected ideal, datasheet or field)");
 }
 

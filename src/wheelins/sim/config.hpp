@@ -22,15 +22,20 @@ class Node;
 namespace wheelins::sim {
 
 /// The effects, each with its own switch. Datasheet: sensor errors and the rolling radius;
-/// field adds the physical effects below `radius`.
+/// field adds the physical effects below `radius`; the last ones are in no profile (switched
+/// on by an option, `--only` or the `effects` key).
 inline const std::vector<std::string>& all_effects() {
   static const std::vector<std::string> e = {
       "gyro_bias", "gyro_gm", "arw", "accel_bias", "accel_gm", "vrw", "scale_factor",
       "misalignment", "quantization", "saturation", "radius",
       // field only
-      "temperature", "vibration", "slip", "skid", "time_offset", "calibration"};
+      "temperature", "vibration", "slip", "skid", "time_offset", "calibration",
+      // in no profile
+      "wheel_noise"};
   return e;
 }
+/// How many of all_effects() the field profile has (the rest are options).
+constexpr std::size_t kFieldEffects = 17;
 /// The effects a profile ("ideal", "datasheet", "field") switches on.
 std::set<std::string> profile_effects(const std::string& profile);
 
@@ -72,6 +77,9 @@ struct ErrorParams {
   double vib_wheel_band[2] = {8.0, 60.0};
   // clocks
   double time_offset = 0.003;  ///< per-module clock offset sigma [s]
+  // white accelerometer noise of the Wheel-IMUs from rolling vibration (effect wheel_noise)
+  double wheel_accel_noise = 1.0 / 60.0;  ///< density in motion at the cruise speed [m/s/sqrt(s)]
+  double wheel_accel_noise_rest = 0.0;    ///< fraction of it at rest [-]
   // calibration residuals of the manifest geometry
   double cal_lever_arm = 0.003;      ///< [m]
   double cal_mounting = 0.3 * kDeg;  ///< [rad]

@@ -219,6 +219,14 @@ J vibration_gain(const ModuleModel& m, const JV& p_o) {
   return x / (1.0 + x) * ((1.0 + xc) / xc);
 }
 
+/// The same gain as a plain number, from the speed of o [m/s].
+double vibration_gain(const ModuleModel& m, double speed) {
+  const double v0 = 0.3 * m.vib_cruise_speed;
+  const double x = speed * speed / (v0 * v0);
+  const double xc = 1.0 / 0.09;
+  return x / (1.0 + x) * ((1.0 + xc) / xc);
+}
+
 void scale(JV& a, const J& g) {
   for (int i = 0; i < 3; ++i) a[i] = a[i] * g;
 }
@@ -735,6 +743,10 @@ std::string Simulation::errors_yaml() const {
     o << "    time_offset_s: " << num(m.time_offset) << "  # a sample stamped t covers (t-dt+offset, t+offset]\n";
     if (!m.vibration.empty())
       o << "    vibration_cruise_speed_m_s: " << num(m.vib_cruise_speed) << "  # the vibration scales with speed\n";
+    if (m.truth.wheel && cfg_.on("wheel_noise"))
+      o << "    wheel_accel_noise_m_s_sqrt_h: " << num(e.wheel_accel_noise * 60.0)
+        << "  # white, each accelerometer axis, at the cruise speed " << num(m.vib_cruise_speed)
+        << " m/s; x " << num(e.wheel_accel_noise_rest) << " at rest, with the vibration gain between\n";
     o << "    temperature_rise_K: " << num(m.temp_rise) << "  # tau " << num(e.temp_tau) << " s\n";
     o << "    position_v_m: {true: " << vec(m.truth.p_inV) << ", manifest: " << vec(m.manifest.p_inV) << "}\n";
     if (m.truth.wheel)
@@ -817,6 +829,7 @@ class ChipErrors {
       : e_(cfg.errors), m_(m),
         gm_g_(cfg.seed, m.name + "/gyro_gm"), gm_a_(cfg.seed, m.name + "/accel_gm"),
         arw_(cfg.seed, m.name + "/gyro_arw"), vrw_(cfg.seed, m.name + "/accel_vrw"),
+        wheel_noise_(cfg.seed, m.name + "/wheel_noise"),
         bg_gm_(m.gyro_gm0), ba_gm_(m.accel_gm0),
         on_gm_g_(cfg.on("gyro_gm")), on_gm_a_(cfg.on("accel_gm")), on_arw_(cfg.on("arw")),
         on_vrw_(cfg.on("vrw")), on_sat_(cfg.on("saturation")), on_q_(cfg.on("quantization")) {
@@ -829,9 +842,10 @@ class ChipErrors {
     s_vrw_ = e_.accel_vrw / std::sqrt(dt);
   }
   /// Advances the processes by one sample and corrupts the true mean rates.
+  /// `wheel_sigma`: the per-sample sigma of the wheel_noise effect now (0: none).
   /// `gyro_step` / `accel_step` (may be null): bias-jump faults added to the bias.
-  void apply(double dT, const Vec3& w, const Vec3& f, Vec3& wm, Vec3& fm, const Vec3* gyro_step = nullptr,
-             const Vec3* accel_step = nullptr) {
+  void apply(double dT, const Vec3& w, const Vec3& f, Vec3& wm, Vec3& fm, double wheel_sigma,
+             const Vec3* gyro_step = nullptr, const Vec3* accel_step = nullptr) {
     if (on_gm_g_)
       for (int i = 0; i < 3; ++i) bg_gm_[i] = phi_g_ * bg_gm_[i] + q_g_ * gm_g_.normal();
     if (on_gm_a_)
@@ -845,6 +859,7 @@ class ChipErrors {
     for (int i = 0; i < 3; ++i) {
       if (on_arw_) wm[i] += s_arw_ * arw_.normal();
       if (on_vrw_) fm[i] += s_vrw_ * vrw_.normal();
+      if (wheel_sigma > 0.0) fm[i] += wheel_sigma * wheel_noise_.normal();
       if (on_sat_) {
         wm[i] = std::clamp(wm[i], -e_.gyro_range, e_.gyro_range);
         fm[i] = std::clamp(fm[i], -e_.accel_range, e_.accel_range);
@@ -861,7 +876,7 @@ class ChipErrors {
  private:
   const ErrorParams& e_;
   const ChipModel& m_;
-  Rng gm_g_, gm_a_, arw_, vrw_;
+  Rng gm_g_, gm_a_, arw_, vrw_, wheel_noise_;
   Vec3 bg_gm_, ba_gm_, bg_ = Vec3::Zero(), ba_ = Vec3::Zero();
   bool on_gm_g_, on_gm_a_, on_arw_, on_vrw_, on_sat_, on_q_;
   double phi_g_, q_g_, phi_a_, q_a_, s_arw_, s_vrw_;
@@ -962,6 +977,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
   auto worker = [&](int g) {
     try {
       const ModuleModel& m = modules_[g];
+      const bool wheel_noise = m.truth.wheel && cfg_.on("wheel_noise");
       GroupStepper st(*this, g, m.time_offset);
       std::unique_ptr<GroupStepper> ideal;
       if (m.time_offset != 0.0) ideal = std::make_unique<GroupStepper>(*this, g, 0.0);
@@ -992,12 +1008,22 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
         const double dT = m.temp_rise * (1.0 - std::exp(-(b + m.time_offset - t0) / cfg_.errors.temp_tau));
         // Sample k is at tau = k / rate since the start of the data (fault times).
         const double tau = static_cast<double>(k) / rate;
+        // Wheel white noise from rolling: its density follows the vibration gain of the speed.
+        double wheel_sigma = 0.0;
+        if (wheel_noise) {
+          const double v = scenario_->state(b + m.time_offset - 0.5 / rate).v_inN.norm();
+          const double rest = cfg_.errors.wheel_accel_noise_rest;
+          wheel_sigma = cfg_.errors.wheel_accel_noise * std::sqrt(rate) *
+                        (rest + (1.0 - rest) * vibration_gain(m, v));
+        }
         for (std::size_t c = 0; c < errs.size(); ++c) {
           Vec3 wm, fm, step_g, step_a;
           // The error model runs on every sample (a dropout or a stuck axis draws the same
           // random numbers), so the data after a sensor fault equal the fault-free run's.
-          if (faults[c].steps(tau, step_g, step_a)) errs[c]->apply(dT, w, f, wm, fm, &step_g, &step_a);
-          else errs[c]->apply(dT, w, f, wm, fm);
+          if (faults[c].steps(tau, step_g, step_a))
+            errs[c]->apply(dT, w, f, wm, fm, wheel_sigma, &step_g, &step_a);
+          else
+            errs[c]->apply(dT, w, f, wm, fm, wheel_sigma);
           faults[c].hold(tau, wm, fm);
           for (int i = 0; i < 3; ++i) row[1 + i] = wm[i], row[4 + i] = fm[i];
           if (!faults[c].dropped(tau)) outs[c]->write(row);
