@@ -51,6 +51,15 @@ inline void write_doubles(const std::filesystem::path& file, const std::vector<d
             static_cast<std::streamsize>(values.size() * sizeof(double)));
 }
 
+/// True if a temporary of `file` (`file.partial-...`) is left beside it.
+inline bool partial_left(const std::filesystem::path& file) {
+  std::error_code ec;
+  const std::string prefix = file.filename().string() + ".partial";
+  for (const auto& e : std::filesystem::directory_iterator(file.parent_path(), ec))
+    if (e.path().filename().string().rfind(prefix, 0) == 0) return true;
+  return false;
+}
+
 /// Runs `f`, expects an InputError, and returns its message ("" and a failure if none).
 inline std::string error_of(const std::function<void()>& f) {
   try {

@@ -96,7 +96,7 @@ TEST(IoImuFile, BinaryAndTextRowsRoundTripExactly) {
     SCOPED_TRACE(to_string(layout));
     const auto file = dir / (std::string("imu.") + to_string(layout));
     write_rows(file, rows, layout);
-    EXPECT_FALSE(std::filesystem::exists(file.string() + ".partial"));
+    EXPECT_FALSE(iotest::partial_left(file));
     ImuFileReader r(file, opts(layout));
     EXPECT_EQ(r.first_time(), rows[0].t);
     ImuSample s;
@@ -342,7 +342,7 @@ TEST(IoImuFile, WriterRefusesToOverwriteAndLeavesNothingWithoutCommit) {
   EXPECT_HAS(error_of([&] { ImuFileWriter w(dir / "a.txt", SampleFormat::kRate, FileLayout::kText); w.write_row({}); w.write_row({}); }),
              "a.txt': record 1 (0-based): time 0 is not after the previous record's 0");
   EXPECT_FALSE(std::filesystem::exists(dir / "a.txt"));
-  EXPECT_FALSE(std::filesystem::exists(dir / "a.txt.partial"));
+  EXPECT_FALSE(iotest::partial_left(dir / "a.txt"));
   ImuRow bad;
   bad.gyro.y() = std::nan("");
   EXPECT_HAS(error_of([&] { ImuFileWriter w(dir / "b.bin"); w.write_row(bad); }), "column 2 (gyro_y): value is not finite");

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "io_test_util.hpp"
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/binary.hpp"
 #include "wheelins/io/trajectory.hpp"
@@ -129,7 +130,7 @@ TEST(IoTruth, WriterRoundTripIsExact) {
   const auto recs = sample_truth(50);
   write_truth(file, recs, false, 2100);
   EXPECT_EQ(fs::file_size(file), 50u * 88u);
-  EXPECT_FALSE(fs::exists(file.string() + ".partial"));
+  EXPECT_FALSE(iotest::partial_left(file));
   const TruthData d = read_truth(file);
   EXPECT_EQ(d.layout, TruthLayout::kGins11);
   EXPECT_TRUE(d.has_velocity_attitude);
@@ -161,7 +162,7 @@ TEST(IoTruth, StreamingWriterValidatesAndCommits) {
     // Destroyed without commit: nothing appears.
   }
   EXPECT_FALSE(fs::exists(file));
-  EXPECT_FALSE(fs::exists(file.string() + ".partial"));
+  EXPECT_FALSE(iotest::partial_left(file));
 }
 
 TEST(IoTruth, FiveColumnLayout) {
@@ -480,7 +481,7 @@ TEST(IoTraj, OverwriteRefusedUnlessAsked) {
     w->write(sample_traj_record(0));
   }
   EXPECT_FALSE(fs::exists(file));
-  EXPECT_FALSE(fs::exists(file.string() + ".partial"));
+  EXPECT_FALSE(iotest::partial_left(file));
 }
 
 TEST(IoTraj, BadInputNamesFileAndLine) {

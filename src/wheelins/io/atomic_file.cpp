@@ -8,6 +8,7 @@
 #include <cstring>
 #include <system_error>
 
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins {
@@ -140,7 +141,7 @@ void append_fixed(std::string& out, double value, int decimals) {
 }
 
 AtomicTextFile::AtomicTextFile(const std::filesystem::path& file, bool overwrite)
-    : file_(file), tmp_(file.string() + ".partial"), overwrite_(overwrite) {
+    : file_(file), tmp_(io_detail::unique_partial(file)), overwrite_(overwrite) {
   check_output_target(file, overwrite);
   if (file.has_parent_path()) {
     std::error_code ec;

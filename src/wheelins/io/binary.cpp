@@ -5,6 +5,7 @@
 #include <cstring>
 #include <system_error>
 
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/nav/types.hpp"
 
 static_assert(std::endian::native == std::endian::little,
@@ -19,14 +20,7 @@ std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'
 
 BinaryRowReader::BinaryRowReader(const std::filesystem::path& file, int ncols)
     : file_(file), ncols_(ncols) {
-  std::error_code ec;
-  const auto st = std::filesystem::status(file, ec);
-  if (ec || !std::filesystem::exists(st))
-    throw InputError(quote(file) + ": file not found");
-  if (std::filesystem::is_directory(st))
-    throw InputError(quote(file) + ": is a directory, expected a binary data file");
-  const auto bytes = std::filesystem::file_size(file, ec);
-  if (ec) throw InputError(quote(file) + ": cannot read size: " + ec.message());
+  const std::uint64_t bytes = io_detail::check_input_file(file, "a binary data file");
   const std::uint64_t row_bytes = sizeof(double) * static_cast<std::uint64_t>(ncols);
   if (bytes % row_bytes != 0)
     throw InputError(quote(file) + ": size " + std::to_string(bytes) +
@@ -61,7 +55,7 @@ const double* BinaryRowReader::next() {
 }
 
 BinaryRowWriter::BinaryRowWriter(const std::filesystem::path& file, int ncols)
-    : file_(file), tmp_(file.string() + ".partial"), ncols_(ncols) {
+    : file_(file), tmp_(io_detail::unique_partial(file)), ncols_(ncols) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
   fp_ = std::fopen(tmp_.c_str(), "wb");
   if (!fp_) throw InputError(quote(tmp_) + ": cannot create: " + std::strerror(errno));

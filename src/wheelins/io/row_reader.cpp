@@ -18,11 +18,7 @@ RowReader::RowReader(const std::filesystem::path& file, FileLayout layout, int n
     bin_ = std::make_unique<BinaryRowReader>(file, ncols);
     return;
   }
-  std::error_code ec;
-  const auto st = std::filesystem::status(file, ec);
-  if (ec || !std::filesystem::exists(st)) throw InputError(quote(file) + ": file not found");
-  if (std::filesystem::is_directory(st))
-    throw InputError(quote(file) + ": is a directory, expected a text data file");
+  io_detail::check_input_file(file, "a text data file");
   text_buf_.resize(1 << 20);
   text_.rdbuf()->pubsetbuf(text_buf_.data(), static_cast<std::streamsize>(text_buf_.size()));
   text_.open(file, std::ios::binary);
@@ -40,7 +36,8 @@ const double* RowReader::next() {
 }
 
 const double* RowReader::next_text() {
-  while (std::getline(text_, line_)) {
+  while (io_detail::bounded_getline(text_, line_, io_detail::kMaxTextLine,
+                                    quote(file_) + ": line " + std::to_string(line_no_ + 1))) {
     ++line_no_;
     const char* p = line_.data();
     const char* end = p + line_.size();

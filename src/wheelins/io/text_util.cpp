@@ -1,6 +1,11 @@
 #include "wheelins/io/text_util.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -10,6 +15,7 @@
 #include <vector>
 
 #include "wheelins/io/diagnostics.hpp"
+#include "wheelins/nav/types.hpp"
 
 namespace wheelins {
 
@@ -20,6 +26,64 @@ WarningSink stderr_sink() {
 namespace io_detail {
 
 std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+std::filesystem::path unique_partial(const std::filesystem::path& file) {
+  static std::atomic<unsigned long> counter{0};
+  return file.string() + ".partial-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+bool bounded_getline(std::istream& in, std::string& line, std::size_t max_len,
+                     const std::string& where) {
+  line.resize(max_len + 1);
+  in.getline(line.data(), static_cast<std::streamsize>(max_len + 1));
+  const auto n = static_cast<std::size_t>(in.gcount());
+  if (in.bad()) {
+    line.clear();
+    return false;
+  }
+  if (in.fail()) {
+    if (n == 0) {  // nothing extracted: the end
+      line.clear();
+      return false;
+    }
+    throw InputError(where + ": a line longer than " + std::to_string(max_len) +
+                     " characters: not a text file of this kind (binary data, or a device?)");
+  }
+  line.resize(in.eof() ? n : n - 1);  // gcount counts the extracted newline
+  return true;
+}
+
+std::uint64_t check_input_file(const std::filesystem::path& file, const std::string& expected) {
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) {
+    const int err = errno;
+    struct stat lst {};
+    const bool is_link = ::lstat(file.c_str(), &lst) == 0 && S_ISLNK(lst.st_mode);
+    if (err == ELOOP)
+      throw InputError(quote(file) + ": too many levels of symbolic links (a loop of links?); "
+                       "expected " + expected);
+    if (err == ENOENT && is_link)
+      throw InputError(quote(file) + ": is a symbolic link to a file that does not exist");
+    if (err == ENOENT) throw InputError(quote(file) + ": file not found");
+    if (err == ENOTDIR)
+      throw InputError(quote(file) + ": file not found (a part of the path is not a directory)");
+    if (err == EACCES) throw InputError(quote(file) + ": permission denied");
+    throw InputError(quote(file) + ": cannot read: " + std::strerror(err));
+  }
+  if (S_ISDIR(st.st_mode)) throw InputError(quote(file) + ": is a directory, expected " + expected);
+  if (!S_ISREG(st.st_mode)) {
+    const char* what = S_ISFIFO(st.st_mode)   ? "a FIFO (named pipe)"
+                       : S_ISCHR(st.st_mode)  ? "a character device"
+                       : S_ISBLK(st.st_mode)  ? "a block device"
+                       : S_ISSOCK(st.st_mode) ? "a socket"
+                                              : "not a regular file";
+    throw InputError(quote(file) + ": is " + std::string(what) + ", expected " + expected +
+                     " (wheelins reads regular files only)");
+  }
+  if (::access(file.c_str(), R_OK) != 0)
+    throw InputError(quote(file) + ": cannot open: " + std::strerror(errno));
+  return static_cast<std::uint64_t>(st.st_size);
+}
 
 std::string format_double(double v) {
   char buf[64];

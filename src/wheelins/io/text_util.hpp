@@ -2,7 +2,9 @@
 // formatting of doubles and strict parsing.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <istream>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -24,6 +26,32 @@ std::optional<double> parse_double(std::string_view s);
 std::optional<long double> parse_long_double(std::string_view s);
 /// Shortest text that parses back to exactly `v` as a long double.
 std::string format_long_double(long double v);
+
+/// Checks that `file` can be read as an input: it exists (a dangling symbolic link and a
+/// loop of links are told apart from a missing file), is not a directory (`expected` names
+/// what was wanted, e.g. "a binary data file"), and is a regular file (a FIFO, a device or a
+/// socket has no size and may never end: refused). Returns its size in bytes. Every failure
+/// is an InputError naming the file.
+std::uint64_t check_input_file(const std::filesystem::path& file, const std::string& expected);
+
+/// The longest line a text data file may have (a longer one is not a data file, e.g.
+/// /dev/zero or a binary file read as text: refused before it fills the memory).
+constexpr std::size_t kMaxTextLine = 1 << 16;
+/// The largest YAML file (manifest, run configuration, simulator settings) read [bytes].
+constexpr std::uint64_t kMaxYamlBytes = 4u << 20;
+/// The deepest nesting of YAML collections accepted.
+constexpr int kMaxYamlDepth = 32;
+/// Warnings of one kind (unknown keys) printed per file; the rest are counted.
+constexpr int kMaxKeyWarnings = 20;
+
+/// std::getline with a bound: false at the end of the stream; a line longer than `max_len`
+/// throws InputError "<where>: line longer than N characters: not a text file of this kind".
+bool bounded_getline(std::istream& in, std::string& line, std::size_t max_len,
+                     const std::string& where);
+
+/// A temporary name beside `file` for writing it, unique to this process and call
+/// (`file.partial-PID-N`): two writers of one file never share (and truncate) a temporary.
+std::filesystem::path unique_partial(const std::filesystem::path& file);
 
 /// Levenshtein distance (for "did you mean" suggestions).
 std::size_t edit_distance(std::string_view a, std::string_view b);

@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins {
@@ -313,11 +314,7 @@ std::string at_line(const std::filesystem::path& file, std::size_t line) {
 }
 
 std::ifstream open_text(const std::filesystem::path& file) {
-  std::error_code ec;
-  const auto st = std::filesystem::status(file, ec);
-  if (ec || !std::filesystem::exists(st)) throw InputError(quote(file) + ": file not found");
-  if (std::filesystem::is_directory(st))
-    throw InputError(quote(file) + ": is a directory, expected a trajectory file");
+  io_detail::check_input_file(file, "a trajectory file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(quote(file) + ": cannot open");
   return in;
@@ -351,7 +348,7 @@ TrajectoryData read_csv(const std::filesystem::path& file) {
   std::vector<const CsvColumn*> setters;
   bool have_header = false;
   std::map<std::string, int> seen;
-  while (std::getline(in, line)) {
+  while (io_detail::bounded_getline(in, line, io_detail::kMaxTextLine, quote(file))) {
     ++lineno;
     if (is_comment_or_blank(line)) continue;
     split(line, ',', fields);
@@ -416,7 +413,7 @@ void read_numeric_rows(const std::filesystem::path& file, std::size_t ncols, con
   std::size_t lineno = 0;
   std::vector<std::string_view> fields;
   double vals[16];
-  while (std::getline(in, line)) {
+  while (io_detail::bounded_getline(in, line, io_detail::kMaxTextLine, quote(file))) {
     ++lineno;
     if (is_comment_or_blank(line)) continue;
     split(line, ' ', fields);
@@ -529,7 +526,7 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& file) {
   std::ifstream in = open_text(file);
   std::string line;
   std::size_t lineno = 0;
-  while (std::getline(in, line)) {
+  while (io_detail::bounded_getline(in, line, io_detail::kMaxTextLine, quote(file))) {
     ++lineno;
     if (is_comment_or_blank(line)) continue;
     const bool letters = std::any_of(line.begin(), line.end(), [](char c) {

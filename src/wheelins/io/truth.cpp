@@ -7,6 +7,7 @@
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/binary.hpp"
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins {
@@ -80,13 +81,7 @@ const char* truth_layout_name(TruthLayout layout) {
 }
 
 TruthLayout detect_truth_layout(const std::filesystem::path& file) {
-  std::error_code ec;
-  const auto st = std::filesystem::status(file, ec);
-  if (ec || !std::filesystem::exists(st)) throw InputError(quote(file) + ": file not found");
-  if (std::filesystem::is_directory(st))
-    throw InputError(quote(file) + ": is a directory, expected a truth file (GINS.bin)");
-  const auto bytes = std::filesystem::file_size(file, ec);
-  if (ec) throw InputError(quote(file) + ": cannot read size: " + ec.message());
+  const std::uint64_t bytes = io_detail::check_input_file(file, "a truth file (GINS.bin)");
   if (bytes == 0) throw InputError(quote(file) + ": empty truth file");
   const bool fits11 = bytes % (8 * kCols11) == 0;
   const bool fits5 = bytes % (8 * kCols5) == 0;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -30,28 +31,129 @@ std::string YamlReader::describe(const YAML::Node& n) {
   }
 }
 
+namespace {
+
+/// The deepest nesting of flow collections ([ and {) in `text`, outside quotes and comments,
+/// and the line where it first passes `limit` (0 if it does not): checked before parsing, so
+/// that a file nested thousands deep is refused before the parser recurses into it.
+std::size_t flow_depth_violation(const std::string& text, int limit) {
+  int depth = 0;
+  std::size_t line = 1;
+  char quote_char = 0;
+  bool comment = false;
+  char prev = '\n';
+  for (char c : text) {
+    if (c == '\n') {
+      ++line;
+      comment = false;
+      if (quote_char == '\'') quote_char = 0;  // a plain scalar's apostrophe, not a quote
+    } else if (comment) {
+    } else if (quote_char) {
+      if (c == quote_char) quote_char = 0;
+    } else if (c == '#' && (prev == ' ' || prev == '\t' || prev == '\n')) {
+      comment = true;
+    } else if ((c == '"' || c == '\'') && (prev == ' ' || prev == '[' || prev == '{' || prev == ',' ||
+                                          prev == ':' || prev == '\n' || prev == '-')) {
+      quote_char = c;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return line;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+    prev = c;
+  }
+  return 0;
+}
+
+/// The deepest nesting of block collections (by indentation levels) in `text`, and the line
+/// where it first passes `limit` (0 if it does not).
+std::size_t block_depth_violation(const std::string& text, int limit) {
+  std::vector<std::size_t> levels;
+  std::size_t line = 0, pos = 0;
+  while (pos < text.size()) {
+    ++line;
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::size_t indent = pos;
+    while (indent < end && text[indent] == ' ') ++indent;
+    if (indent < end && text[indent] != '#' && text[indent] != '\r') {
+      const std::size_t col = indent - pos;
+      while (!levels.empty() && levels.back() > col) levels.pop_back();
+      if (levels.empty() || levels.back() < col) levels.push_back(col);
+      if (levels.size() > static_cast<std::size_t>(limit)) return line;
+    }
+    pos = end + 1;
+  }
+  return 0;
+}
+
+/// The nesting depth of a parsed tree, stopping once past `limit`.
+int tree_depth(const YAML::Node& n, int limit, int depth = 1) {
+  if (depth > limit || !(n.IsMap() || n.IsSequence())) return depth;
+  int deepest = depth;
+  for (const auto& kv : n) {
+    const YAML::Node child = n.IsMap() ? kv.second : YAML::Node(kv);
+    deepest = std::max(deepest, tree_depth(child, limit, depth + 1));
+    if (deepest > limit) break;
+  }
+  return deepest;
+}
+
+}  // namespace
+
+YAML::Node load_yaml_file(const fs::path& file, const std::string& kind,
+                          const std::string& directory_hint) {
+  const std::string where = io_detail::quote(file);
+  std::uint64_t bytes = 0;
+  try {
+    bytes = io_detail::check_input_file(file, "a " + kind + " file" + directory_hint);
+  } catch (const InputError& e) {
+    if (std::string(e.what()) == where + ": file not found") throw InputError(where + ": " + kind + " file not found");
+    throw;
+  }
+  if (bytes > io_detail::kMaxYamlBytes)
+    throw InputError(where + ": " + std::to_string(bytes) + " bytes; a " + kind +
+                     " file has at most " + std::to_string(io_detail::kMaxYamlBytes >> 20) +
+                     " MiB (is this the right file?)");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(where + ": cannot open: " + std::strerror(errno));
+  std::string text(static_cast<std::size_t>(bytes), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(bytes));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.find('\0') != std::string::npos)
+    throw InputError(where + ": contains NUL bytes: a binary file, not a " + kind + " (YAML text)");
+  std::size_t line = flow_depth_violation(text, io_detail::kMaxYamlDepth);
+  if (!line) line = block_depth_violation(text, io_detail::kMaxYamlDepth);
+  if (line)
+    throw InputError(where + ": line " + std::to_string(line) + ": lists or mappings nested deeper than " +
+                     std::to_string(io_detail::kMaxYamlDepth) + " levels; a " + kind + " needs a few");
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    std::string at;
+    if (!e.mark.is_null())
+      at = "line " + std::to_string(e.mark.line + 1) + ", column " + std::to_string(e.mark.column + 1) + ": ";
+    throw InputError(where + ": " + at + "malformed YAML: " + e.msg);
+  }
+  if (tree_depth(root, io_detail::kMaxYamlDepth) > io_detail::kMaxYamlDepth)
+    throw InputError(where + ": lists or mappings nested deeper than " +
+                     std::to_string(io_detail::kMaxYamlDepth) + " levels; a " + kind + " needs a few");
+  return root;
+}
+
 YamlReader::YamlReader(const fs::path& file, WarningSink warn, std::string kind,
                        std::string directory_hint)
     : file_(file), warn_(std::move(warn)) {
-  std::error_code ec;
-  const auto st = fs::status(file_, ec);
-  if (ec || !fs::exists(st)) fail("", kind + " file not found");
-  if (fs::is_directory(st)) fail("", "is a directory, expected a " + kind + " file" + directory_hint);
-  std::ifstream in(file_, std::ios::binary);
-  if (!in) fail("", std::string("cannot open: ") + std::strerror(errno));
-  std::stringstream buf;
-  buf << in.rdbuf();
-  try {
-    root_ = YAML::Load(buf.str());
-  } catch (const YAML::Exception& e) {
-    std::string where;
-    if (!e.mark.is_null())
-      where = "line " + std::to_string(e.mark.line + 1) + ", column " +
-              std::to_string(e.mark.column + 1) + ": ";
-    fail("", where + "malformed YAML: " + e.msg);
-  }
+  root_ = load_yaml_file(file_, kind, directory_hint);
   if (!root_.IsDefined() || root_.IsNull()) fail("", "the " + kind + " is empty");
   require_map(root_, "");
+}
+
+YamlReader::~YamlReader() {
+  if (warn_ && key_warnings_ > io_detail::kMaxKeyWarnings)
+    warn_(io_detail::quote(file_) + ": " + std::to_string(key_warnings_ - io_detail::kMaxKeyWarnings) +
+          " more unknown keys ignored (not reported one by one)");
 }
 
 void YamlReader::fail(const std::string& key, const std::string& what, const YAML::Node* at) const {
@@ -80,7 +182,7 @@ void YamlReader::check_keys(const YAML::Node& map, const std::string& path,
       const std::pair<int, std::size_t> score{extends ? 0 : 1, io_detail::edit_distance(key, k)};
       if (score < best_score) best_score = score, best = k;
     }
-    if (warn_) {
+    if (warn_ && ++key_warnings_ <= io_detail::kMaxKeyWarnings) {
       std::string msg = io_detail::quote(file_) + ": " + join(path, key) + ": unknown key ignored";
       if (!kv.first.Mark().is_null()) msg += " (line " + std::to_string(kv.first.Mark().line + 1) + ")";
       if (!best.empty()) msg += "; did you mean '" + best + "'?";
@@ -162,6 +264,25 @@ std::vector<double> YamlReader::number_list(const YAML::Node& v, const std::stri
 
 void YamlReader::positive(double x, const std::string& path, const YAML::Node& at) const {
   if (!(x > 0.0)) fail(path, "must be > 0, got " + io_detail::format_double(x), &at);
+}
+
+}  // namespace wheelins
+
+namespace wheelins {
+
+void YamlReader::range(double x, double lo, double hi, const std::string& path, const YAML::Node& at,
+                       const std::string& unit) const {
+  if (!(x >= lo && x <= hi))
+    fail(path, "must be in [" + io_detail::format_double(lo) + ", " + io_detail::format_double(hi) +
+                   "]" + (unit.empty() ? "" : " " + unit) + ", got " + io_detail::format_double(x),
+         &at);
+}
+
+double YamlReader::number_in(const YAML::Node& v, const std::string& path, double lo, double hi,
+                             const std::string& unit) const {
+  const double x = number(v, path);
+  range(x, lo, hi, path, v, unit);
+  return x;
 }
 
 }  // namespace wheelins

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,12 @@
 
 namespace wheelins {
 
+/// Reads and parses a YAML file with the checks every YAML input gets: a regular file
+/// (io_detail::check_input_file), at most io_detail::kMaxYamlBytes, no NUL bytes, nested at
+/// most io_detail::kMaxYamlDepth deep. `kind` names the file in messages.
+YAML::Node load_yaml_file(const std::filesystem::path& file, const std::string& kind,
+                          const std::string& directory_hint = "");
+
 class YamlReader {
  public:
   /// Parses `file` (InputError if missing, a directory, unreadable, malformed or empty).
@@ -23,6 +30,11 @@ class YamlReader {
   /// is appended when a directory was given instead.
   YamlReader(const std::filesystem::path& file, WarningSink warn, std::string kind = "YAML",
              std::string directory_hint = "");
+
+  /// Reports how many unknown-key warnings were held back (past io_detail::kMaxKeyWarnings).
+  ~YamlReader();
+  YamlReader(const YamlReader&) = delete;
+  YamlReader& operator=(const YamlReader&) = delete;
 
   const YAML::Node& root() const { return root_; }
   const std::filesystem::path& file() const { return file_; }
@@ -46,6 +58,12 @@ class YamlReader {
   std::vector<std::string> text_list(const YAML::Node& v, const std::string& path) const;
   std::vector<double> number_list(const YAML::Node& v, const std::string& path) const;
   void positive(double x, const std::string& path, const YAML::Node& at) const;
+  /// Fails unless lo <= x <= hi (the key's physical range; `unit` for the message, e.g. "m").
+  void range(double x, double lo, double hi, const std::string& path, const YAML::Node& at,
+             const std::string& unit) const;
+  /// A number read and checked against its range in one step.
+  double number_in(const YAML::Node& v, const std::string& path, double lo, double hi,
+                   const std::string& unit) const;
 
   template <class E>
   E choice(const YAML::Node& v, const std::string& path,
@@ -66,6 +84,7 @@ class YamlReader {
   std::filesystem::path file_;
   WarningSink warn_;
   YAML::Node root_;
+  mutable int key_warnings_ = 0;  ///< unknown keys seen (check_keys is const)
 };
 
 }  // namespace wheelins

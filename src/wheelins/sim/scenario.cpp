@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "wheelins/io/binary.hpp"
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins::sim {
@@ -282,6 +283,8 @@ struct RawPoint {
 };
 
 std::vector<RawPoint> read_kml(const std::filesystem::path& file) {
+  if (io_detail::check_input_file(file, "a KML path file") > (std::uint64_t{256} << 20))
+    throw InputError(quote(file) + ": larger than 256 MiB: not a path file");
   std::ifstream in(file);
   if (!in) throw InputError(quote(file) + ": cannot open");
   std::stringstream ss;
@@ -331,6 +334,7 @@ std::vector<RawPoint> read_kml(const std::filesystem::path& file) {
 /// (names lat/latitude, lon/lng/longitude, h/height/alt; north/n, east/e); without a
 /// header: lat,lon. '#' starts a comment; separators: comma, semicolon, whitespace.
 std::vector<RawPoint> read_csv(const std::filesystem::path& file, bool& local_metres) {
+  io_detail::check_input_file(file, "a CSV path file");
   std::ifstream in(file);
   if (!in) throw InputError(quote(file) + ": cannot open");
   std::string line;
@@ -348,7 +352,7 @@ std::vector<RawPoint> read_csv(const std::filesystem::path& file, bool& local_me
     while (is >> x) f.push_back(x);
     return f;
   };
-  while (std::getline(in, line)) {
+  while (io_detail::bounded_getline(in, line, io_detail::kMaxTextLine, quote(file))) {
     ++lineno;
     if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
     const auto f = split(line);
