@@ -150,6 +150,10 @@ const bool registered = cli::register_command(
                      "north/east/down-only trajectories (TUM, traj.txt) must be in this frame");
       sub.add_flag("--force", o->force, "Overwrite existing --json / --series files");
       return [o]() {
+        if (!(o->segment >= eval::kMinSegment && o->segment <= eval::kMaxSegment))
+          throw InputError("--segment " + std::to_string(o->segment) + ": must be in [1, 1e6] m");
+        if (!(o->max_gap > 0.0 && o->max_gap <= 3600.0))
+          throw InputError("--max-gap " + std::to_string(o->max_gap) + ": must be in (0, 3600] s");
         const TruthLayout layout = truth_layout_from_name(o->truth_layout);
         const TrajectoryFormat format = trajectory_format_from_name(o->format);
         if (format == TrajectoryFormat::kKml)
@@ -170,6 +174,14 @@ const bool registered = cli::register_command(
         // With JSON on stdout the table goes to stderr, so stdout stays parseable.
         std::ostream& table = o->json == "-" ? std::cerr : std::cout;
         print_table(table, res, truth_layout_name(truth.layout));
+        if (!traj.records.empty()) {
+          const double span = traj.records.back().t - traj.records.front().t;
+          if (res.duration < 0.95 * span - 1.0)
+            std::cerr << "warning: the evaluation covers " << fmt(res.duration, 1, " s") << " of the "
+                      << fmt(span, 1, " s") << " trajectory: the truth is shorter, has a gap or a "
+                      << "clock jump (" << res.skipped_outside << " truth epochs outside the trajectory, "
+                      << res.skipped_gap << " in its gaps); the figures are for that part only\n";
+        }
         if (!traj.has_lla && !o->align && o->origin.empty())
           table << "note: " << o->traj << " has north/east/down only; it was taken to be relative "
                 << "to the first truth record (use --origin or --align otherwise)\n";

@@ -25,6 +25,9 @@ std::vector<double> drift_rate_curve(const std::vector<double>& s, const std::ve
                                      double segment_length) {
   std::vector<double> curve;
   if (s.empty() || s.size() != err.size() || !(segment_length > 0.0)) return curve;
+  if (!std::isfinite(s.back()) || s.back() / segment_length > 1e7)
+    throw InputError("drift rate: " + std::to_string(s.back()) + " m in segments of " +
+                     std::to_string(segment_length) + " m is more than 10^7 segments");
   // Tiny slack so that a distance of exactly k*l computed by summation still counts.
   const double slack = 1e-9 * std::max(1.0, s.back());
   const auto K = static_cast<std::size_t>(std::floor((s.back() + slack) / segment_length));
@@ -186,9 +189,12 @@ struct Evaluator::State {
 
 Evaluator::Evaluator(const earth::LocalFrame& frame, const Sources& sources,
                      const EvalOptions& opt, bool keep_series) {
-  if (!(opt.segment_length > 0.0) || !std::isfinite(opt.segment_length))
-    throw InputError("segment length must be a positive number of metres");
-  if (!(opt.max_gap > 0.0)) throw InputError("maximum interpolation gap must be positive");
+  // Bounded work and memory: the drift curve has distance / l entries, so l has a floor.
+  if (!(opt.segment_length >= kMinSegment && opt.segment_length <= kMaxSegment))
+    throw InputError("segment length must be in [" + std::to_string(static_cast<int>(kMinSegment)) +
+                     ", 1e6] m, got " + std::to_string(opt.segment_length));
+  if (!(opt.max_gap > 0.0 && opt.max_gap <= 3600.0))
+    throw InputError("maximum interpolation gap must be in (0, 3600] s, got " + std::to_string(opt.max_gap));
   s_ = std::make_unique<State>(frame, sources, opt, keep_series);
   EvalResult& r = s_->res;
   r.truth_file = sources.truth_file;
@@ -236,6 +242,15 @@ void Evaluator::add_trajectory(const TrajectoryRecord& r) {
                      " (0-based): time " + std::to_string(r.t) +
                      (s.n_traj > 0 ? " is not after the previous record's " + std::to_string(s.b.t)
                                    : std::string(" is not a finite number")));
+  // The same verdict as the trajectory file readers: a non-finite position is an error,
+  // never an epoch compared as NaN (which every "max" and "within" test would pass).
+  const bool pos_ok = s.src.traj_has_lla
+                          ? std::isfinite(r.lla.lat) && std::isfinite(r.lla.lon) && std::isfinite(r.lla.h)
+                          : r.p_inN.allFinite();
+  if (!pos_ok || (s.src.traj_has_heading && !std::isfinite(r.rpy.z())))
+    throw InputError(quote(s.res.traj_file) + ": record " + std::to_string(s.n_traj) +
+                     " (0-based, t=" + std::to_string(r.t) + "): " +
+                     (pos_ok ? "heading" : "position") + " is not finite");
   State::Sample k;
   k.t = r.t;
   k.p = s.src.traj_has_lla ? s.frame.ned_from_geodetic(r.lla) : r.p_inN;

@@ -46,6 +46,9 @@
 
 namespace wheelins::eval {
 
+/// The drift-rate segment length's range [m]: the curve has distance / l entries.
+constexpr double kMinSegment = 1.0, kMaxSegment = 1e6;
+
 struct EvalOptions {
   double segment_length = 100.0;  ///< l [m] of the drift rate
   bool align = false;             ///< shift + rotate the trajectory onto the truth at the start

@@ -87,8 +87,8 @@ Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& m
                      std::to_string(subs_.size()) + " modules");
   const double wsum = std::accumulate(weights_.begin(), weights_.end(), 0.0);
   for (double w : weights_)
-    if (!(w >= 0.0) || !(wsum > 0.0))
-      throw InputError("fusion weights must be >= 0 with a positive sum");
+    if (!(w > 0.0) || !std::isfinite(wsum))  // a zero weight leaves the mean undefined when the others drop out
+      throw InputError("fusion weights must be > 0 and finite (leave a module out instead of weighting it 0)");
   for (double& w : weights_) w /= wsum;
   if (subs_.size() > static_cast<std::size_t>(kMaxModules))
     throw InputError(std::to_string(subs_.size()) + " modules selected; at most " +

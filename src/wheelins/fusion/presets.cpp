@@ -53,6 +53,15 @@ std::vector<std::string> configuration_modules(const Manifest& m, const std::str
         break;
       }
     }
+    // A lone Wheel-IMU (a manifest with no left one, e.g. the public single-IMU layout with
+    // its wheel on the right) serves as the configuration's wheel when there is no right slot.
+    if (!pick && chips.empty() && slots[i] == Slot::kLeft &&
+        std::find(slots.begin(), slots.end(), Slot::kRight) == slots.end())
+      for (const auto& mod : m.modules)
+        if (mod.kind == ModuleKind::kWheel) {
+          pick = &mod;
+          break;
+        }
     if (!pick)
       throw InputError("'" + m.path.string() + "': configuration '" + name + "' needs a " +
                        slot_name(slots[i]) + " IMU" +

@@ -8,6 +8,14 @@
 namespace wheelins {
 namespace fs = std::filesystem;
 
+namespace {
+/// Ranges shared with the command line (app/cmd_run.cpp checks the same).
+struct Ranges {
+  double duration[2] = {0.0, 1e7};
+  double output_interval[2] = {0.0, 5.0};
+} const kRange;
+}  // namespace
+
 SpeedSharing speed_sharing_from_name(const std::string& name) {
   if (name == "mean") return SpeedSharing::kMean;
   if (name == "own") return SpeedSharing::kOwn;
@@ -32,8 +40,8 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   if (auto v = y.get(root, "chips"); v.IsDefined()) c.chips = y.text_list(v, "chips");
   if (auto v = y.get(root, "modules"); v.IsDefined()) c.modules = y.text_list(v, "modules");
   if (auto v = y.get(root, "duration_s"); v.IsDefined()) {
-    c.max_duration = y.number(v, "duration_s");
-    y.positive(c.max_duration, "duration_s", v);
+    c.max_duration = y.number_in(v, "duration_s", kRange.duration[0], kRange.duration[1], "s");
+    if (c.max_duration <= 0) y.fail("duration_s", "must be > 0 s (leave it out for all the data)", &v);
   }
 
   if (auto out = y.get(root, "output"); out.IsDefined()) {
@@ -49,8 +57,8 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
       }
     }
     if (auto v = y.get(out, "interval_s"); v.IsDefined()) {
-      c.nav.output_interval = y.number(v, "output.interval_s");
-      if (c.nav.output_interval < 0) y.fail("output.interval_s", "must be >= 0", &v);
+      c.nav.output_interval = y.number_in(v, "output.interval_s", kRange.output_interval[0],
+                                          kRange.output_interval[1], "s (0 = every epoch)");
     }
     if (auto v = y.get(out, "overwrite"); v.IsDefined()) c.overwrite = y.boolean(v, "output.overwrite");
     if (auto v = y.get(out, "subsystems"); v.IsDefined())
@@ -72,48 +80,46 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
       c.earth_rotation = y.choice<std::string>(v, "filter.earth_rotation",
                                                {{"auto", "auto"}, {"true", "true"}, {"false", "false"}});
     if (auto v = y.get(f, "covariance_interval_s"); v.IsDefined()) {
-      c.nav.covariance_interval = y.number(v, "filter.covariance_interval_s");
-      if (c.nav.covariance_interval < 0 || c.nav.covariance_interval > 0.5)
-        y.fail("filter.covariance_interval_s", "must be in [0, 0.5] s", &v);
+      c.nav.covariance_interval = y.number_in(v, "filter.covariance_interval_s", 0.0, 0.5,
+                                              "s (0 = every epoch)");
     }
     if (auto v = y.get(f, "velocity_update_hz"); v.IsDefined()) {
-      const double hz = y.number(v, "filter.velocity_update_hz");
-      y.positive(hz, "filter.velocity_update_hz", v);
+      const double hz = y.number_in(v, "filter.velocity_update_hz", 0.05, 100.0, "Hz");
       c.nav.wheel.velocity_update_interval = 1.0 / hz;
     }
     if (auto v = y.get(f, "speed_window_s"); v.IsDefined()) {
-      c.nav.wheel.speed_window = y.number(v, "filter.speed_window_s");
-      y.positive(c.nav.wheel.speed_window, "filter.speed_window_s", v);
+      c.nav.wheel.speed_window = y.number_in(v, "filter.speed_window_s", 0.001, 2.0, "s");
     }
     auto stds = [&](const char* key, Vec3& out) {
       if (auto v = y.get(f, key); v.IsDefined()) {
         const std::string path = std::string("filter.") + key;
         out = y.vec3(v, path);
-        for (int i = 0; i < 3; ++i) y.positive(out[i], path, v);
+        for (int i = 0; i < 3; ++i)
+          y.range(out[i], 1e-4, 10.0, YamlReader::index_path(path, static_cast<std::size_t>(i)), v, "m/s");
       }
     };
     stds("wheel_velocity_std_m_s", c.nav.wheel.velocity_std);
     stds("body_velocity_std_m_s", c.nav.body.velocity_std);
     if (auto v = y.get(f, "velocity_gate"); v.IsDefined()) {
-      c.nav.wheel.gate = c.nav.body.gate = y.number(v, "filter.velocity_gate");
-      if (c.nav.wheel.gate < 0) y.fail("filter.velocity_gate", "must be >= 0 (0 = off)", &v);
+      c.nav.wheel.gate = c.nav.body.gate =
+          y.number_in(v, "filter.velocity_gate", 0.0, 1e4, "(test ratio; 0 = off)");
     }
     if (auto s = y.get(f, "initial_std"); s.IsDefined()) {
       y.require_map(s, "filter.initial_std");
       y.check_keys(s, "filter.initial_std",
                    {"position_m", "velocity_m_s", "roll_pitch_deg", "heading_deg"});
       InitialUncertainty& u = c.nav.wheel.init;
-      auto one = [&](const char* key, double& out, double factor) {
+      auto one = [&](const char* key, double& out, double factor, double lo, double hi,
+                     const char* unit) {
         if (auto v = y.get(s, key); v.IsDefined()) {
           const std::string path = std::string("filter.initial_std.") + key;
-          out = y.number(v, path) * factor;
-          y.positive(out, path, v);
+          out = y.number_in(v, path, lo, hi, unit) * factor;
         }
       };
-      one("position_m", u.position, 1.0);
-      one("velocity_m_s", u.velocity, 1.0);
-      one("roll_pitch_deg", u.roll_pitch, kDeg);
-      one("heading_deg", u.heading, kDeg);
+      one("position_m", u.position, 1.0, 1e-4, 1000.0, "m");
+      one("velocity_m_s", u.velocity, 1.0, 1e-4, 100.0, "m/s");
+      one("roll_pitch_deg", u.roll_pitch, kDeg, 1e-3, 90.0, "deg");
+      one("heading_deg", u.heading, kDeg, 1e-3, 180.0, "deg");
       c.nav.body.init = u;
     }
   }
@@ -130,19 +136,26 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     if (auto v = y.get(f, "position_constraint"); v.IsDefined())
       o.position_constraint = y.boolean(v, "fusion.position_constraint");
     if (auto v = y.get(f, "position_update_hz"); v.IsDefined()) {
-      const double hz = y.number(v, "fusion.position_update_hz");
-      y.positive(hz, "fusion.position_update_hz", v);
+      const double hz = y.number_in(v, "fusion.position_update_hz", 0.01, 100.0, "Hz");
       o.position_update_interval = 1.0 / hz;
     }
     if (auto v = y.get(f, "position_std_m"); v.IsDefined()) {
-      o.position_std = y.number(v, "fusion.position_std_m");
-      y.positive(o.position_std, "fusion.position_std_m", v);
+      o.position_std = y.number_in(v, "fusion.position_std_m", 1e-3, 100.0, "m");
     }
     if (auto v = y.get(f, "position_gate"); v.IsDefined()) {
-      o.position_gate = y.number(v, "fusion.position_gate");
-      if (o.position_gate < 0) y.fail("fusion.position_gate", "must be >= 0 (0 = off)", &v);
+      o.position_gate = y.number_in(v, "fusion.position_gate", 0.0, 1e4, "(test ratio; 0 = off)");
     }
-    if (auto v = y.get(f, "weights"); v.IsDefined()) o.weights = y.number_list(v, "fusion.weights");
+    if (auto v = y.get(f, "weights"); v.IsDefined()) {
+      o.weights = y.number_list(v, "fusion.weights");
+      if (o.weights.empty()) y.fail("fusion.weights", "an empty list (leave it out for equal weights)", &v);
+      for (std::size_t i = 0; i < o.weights.size(); ++i)
+        if (!(o.weights[i] > 0.0) || o.weights[i] > 1e6)
+          y.fail(YamlReader::index_path("fusion.weights", i),
+                 "must be in (0, 1e6], got " + std::to_string(o.weights[i]) +
+                     " (every module of the run needs a positive weight; leave a module out of "
+                     "the configuration instead of giving it weight 0)",
+                 &v);
+    }
     if (auto v = y.get(f, "centralized"); v.IsDefined()) o.centralized = y.boolean(v, "fusion.centralized");
   }
 
@@ -152,19 +165,21 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
       const char* name;
       double FaultOptions::*member;
       double unit;
+      double lo, hi;
+      const char* unit_name;
     };
     static const Key kKeys[] = {
-        {"stale_after_s", &FaultOptions::stale_after, 1.0},
-        {"max_gap_s", &FaultOptions::max_gap, 1.0},
-        {"realign_s", &FaultOptions::realign_time, 1.0},
-        {"probation_s", &FaultOptions::probation, 1.0},
-        {"retry_after_s", &FaultOptions::retry_after, 1.0},
-        {"speed_gate_sigma", &FaultOptions::speed_gate, 1.0},
-        {"wheel_mismatch_m_s", &FaultOptions::wheel_mismatch, 1.0},
-        {"test_ratio", &FaultOptions::test_ratio, 1.0},
-        {"heading_gate_deg", &FaultOptions::heading_gate, kDeg},
-        {"saturation_margin", &FaultOptions::saturation_margin, 1.0},
-        {"saturation_hold_s", &FaultOptions::saturation_hold, 1.0}};
+        {"stale_after_s", &FaultOptions::stale_after, 1.0, 0.001, 60.0, "s"},
+        {"max_gap_s", &FaultOptions::max_gap, 1.0, 0.001, 60.0, "s"},
+        {"realign_s", &FaultOptions::realign_time, 1.0, 0.01, 60.0, "s"},
+        {"probation_s", &FaultOptions::probation, 1.0, 0.01, 3600.0, "s"},
+        {"retry_after_s", &FaultOptions::retry_after, 1.0, 0.01, 3600.0, "s"},
+        {"speed_gate_sigma", &FaultOptions::speed_gate, 1.0, 0.1, 1e4, "sigma"},
+        {"wheel_mismatch_m_s", &FaultOptions::wheel_mismatch, 1.0, 1e-3, 100.0, "m/s"},
+        {"test_ratio", &FaultOptions::test_ratio, 1.0, 0.1, 1e6, ""},
+        {"heading_gate_deg", &FaultOptions::heading_gate, kDeg, 0.01, 180.0, "deg"},
+        {"saturation_margin", &FaultOptions::saturation_margin, 1.0, 0.5, 1.0, "(of the full scale)"},
+        {"saturation_hold_s", &FaultOptions::saturation_hold, 1.0, 0.001, 60.0, "s"}};
     std::vector<std::string> names{"enabled", "window", "max_failed", "heading_epochs"};
     for (const auto& k : kKeys) names.push_back(k.name);
     y.check_keys(f, "faults", names);
@@ -173,8 +188,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     for (const auto& k : kKeys)
       if (auto v = y.get(f, k.name); v.IsDefined()) {
         const std::string path = std::string("faults.") + k.name;
-        const double x = y.number(v, path);
-        y.positive(x, path, v);
+        const double x = y.number_in(v, path, k.lo, k.hi, k.unit_name);
         o.*k.member = x * k.unit;
       }
     auto integer = [&](const char* name, int& out) {

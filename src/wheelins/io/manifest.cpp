@@ -110,25 +110,28 @@ const std::vector<std::string> kVehicleKeys = {"track_m"};
 const std::vector<std::string> kModuleKeys = {
     "name",          "kind",          "group",        "chip",      "file",
     "format",        "layout",        "rate_hz",      "time_offset_s", "position_v_m",
-    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "wheel_radius_m", "gyro_range_dps", "noise"};
+    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "wheel_radius_m", "gyro_range_dps",
+    "accel_range_m_s2", "noise"};
 
 /// One noise key: its name, its unit factor and the ImuNoise member it fills.
 struct NoiseKey {
   const char* key;
   Unit unit;
   double ImuNoise::*member;
+  double lo, hi;  ///< the physical range, in the key's unit (docs/manifest.md)
+  const char* unit_name;
 };
 const NoiseKey kNoiseKeys[] = {
-    {"gyro_arw_deg_sqrt_h", kArwU, &ImuNoise::gyro_arw},
-    {"acc_vrw_m_s_sqrt_h", kVrwU, &ImuNoise::acc_vrw},
-    {"gyro_bias_deg_h", kDegPerHourU, &ImuNoise::gyro_bias_std},
-    {"acc_bias_m_s2", kOne, &ImuNoise::acc_bias_std},
-    {"gyro_sf_ppm", kPpmU, &ImuNoise::gyro_sf_std},
-    {"acc_sf_ppm", kPpmU, &ImuNoise::acc_sf_std},
-    {"gyro_bias_tau_h", kHourU, &ImuNoise::gyro_bias_tau},
-    {"acc_bias_tau_h", kHourU, &ImuNoise::acc_bias_tau},
-    {"gyro_sf_tau_h", kHourU, &ImuNoise::gyro_sf_tau},
-    {"acc_sf_tau_h", kHourU, &ImuNoise::acc_sf_tau},
+    {"gyro_arw_deg_sqrt_h", kArwU, &ImuNoise::gyro_arw, 1e-4, 100.0, "deg/sqrt(h)"},
+    {"acc_vrw_m_s_sqrt_h", kVrwU, &ImuNoise::acc_vrw, 1e-4, 100.0, "m/s/sqrt(h)"},
+    {"gyro_bias_deg_h", kDegPerHourU, &ImuNoise::gyro_bias_std, 1e-3, 1e5, "deg/h"},
+    {"acc_bias_m_s2", kOne, &ImuNoise::acc_bias_std, 1e-6, 10.0, "m/s^2"},
+    {"gyro_sf_ppm", kPpmU, &ImuNoise::gyro_sf_std, 1e-3, 2e5, "ppm"},
+    {"acc_sf_ppm", kPpmU, &ImuNoise::acc_sf_std, 1e-3, 2e5, "ppm"},
+    {"gyro_bias_tau_h", kHourU, &ImuNoise::gyro_bias_tau, 1e-3, 1e4, "h"},
+    {"acc_bias_tau_h", kHourU, &ImuNoise::acc_bias_tau, 1e-3, 1e4, "h"},
+    {"gyro_sf_tau_h", kHourU, &ImuNoise::gyro_sf_tau, 1e-3, 1e4, "h"},
+    {"acc_sf_tau_h", kHourU, &ImuNoise::acc_sf_tau, 1e-3, 1e4, "h"},
 };
 
 std::vector<std::string> noise_key_names() {
@@ -206,6 +209,10 @@ Manifest Loader::load() {
       fail("static_period_s", "end " + format_double(m.static_end) + " is before start " +
                                   format_double(m.static_start),
            &v);
+    if (m.static_end - m.static_start > 3600.0)
+      fail("static_period_s", "lasts " + format_double(m.static_end - m.static_start) +
+                                  " s; a static period lasts at most 3600 s (is it in seconds?)",
+           &v);
   }
 
   {
@@ -224,13 +231,15 @@ Manifest Loader::load() {
       fail("initial.lon_deg", "longitude must be within [-360, 360] deg, got " + format_double(lon_deg), &lon);
     m.origin.lat = number(lat, "initial.lat_deg", kDegU);
     m.origin.lon = number(lon, "initial.lon_deg", kDegU);
+    range(number(h, "initial.h_m"), -1000.0, 10000.0, "initial.h_m", h, "m (ellipsoidal)");
+    range(number(hd, "initial.heading_deg"), -360.0, 360.0, "initial.heading_deg", hd, "deg");
     m.origin.h = number(h, "initial.h_m");
     m.initial_heading = number(hd, "initial.heading_deg", kDegU);
   }
 
   if (auto v = get(root, "gravity_m_s2"); v.IsDefined()) {
     const double g = number(v, "gravity_m_s2");
-    positive(g, "gravity_m_s2", v, "gravity magnitude");
+    range(g, 9.7, 9.9, "gravity_m_s2", v, "m/s^2 (gravity on the earth's surface)");
     m.gravity = g;
   }
   if (auto v = get(root, "earth_rotation"); v.IsDefined()) m.earth_rotation = boolean(v, "earth_rotation");
@@ -239,8 +248,7 @@ Manifest Loader::load() {
     check_keys(veh, "vehicle", kVehicleKeys);
     if (auto v = get(veh, "track_m"); v.IsDefined()) {
       m.track_width = number(v, "vehicle.track_m");
-      if (m.track_width < 0.0)
-        fail("vehicle.track_m", "must be >= 0 (0: unknown), got " + format_double(m.track_width), &v);
+      range(m.track_width, 0.0, 10.0, "vehicle.track_m", v, "m (0: unknown)");
     }
   }
 
@@ -281,12 +289,21 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
                                   {{"binary", FileLayout::kBinary}, {"text", FileLayout::kText}});
   if (auto v = get(n, "rate_hz"); v.IsDefined()) {
     s.rate_hz = number(v, join(path, "rate_hz"));
-    positive(s.rate_hz, join(path, "rate_hz"), v, "a sample rate");
+    range(s.rate_hz, 1.0, 10000.0, join(path, "rate_hz"), v, "Hz");
   }
-  if (auto v = get(n, "time_offset_s"); v.IsDefined()) s.time_offset = number(v, join(path, "time_offset_s"));
-  if (auto v = get(n, "position_v_m"); v.IsDefined()) s.p_inV = vec3(v, join(path, "position_v_m"));
+  if (auto v = get(n, "time_offset_s"); v.IsDefined()) {
+    s.time_offset = number(v, join(path, "time_offset_s"));
+    range(s.time_offset, -1e7, 1e7, join(path, "time_offset_s"), v, "s");
+  }
+  auto vec_in = [&](const YAML::Node& v, const std::string& p, double lim) {
+    const Vec3 x = vec3(v, p);
+    for (std::size_t i = 0; i < 3; ++i)
+      range(x[static_cast<int>(i)], -lim, lim, index_path(p, i), v, "m");
+    return x;
+  };
+  if (auto v = get(n, "position_v_m"); v.IsDefined()) s.p_inV = vec_in(v, join(path, "position_v_m"), 20.0);
   if (auto v = get(n, "lever_arm_b_m"); v.IsDefined())
-    s.lever_arm_inB = vec3(v, join(path, "lever_arm_b_m"));
+    s.lever_arm_inB = vec_in(v, join(path, "lever_arm_b_m"), s.kind == ModuleKind::kWheel ? 1.0 : 20.0);
   if (auto v = get(n, "mounting_deg"); v.IsDefined()) {
     const std::string p = join(path, "mounting_deg");
     const Vec3 deg = vec3(v, p);
@@ -308,16 +325,21 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
   if (auto v = get(n, "wheel_radius_m"); v.IsDefined()) {
     s.wheel_radius = number(v, join(path, "wheel_radius_m"));
     if (s.kind == ModuleKind::kWheel)
-      positive(s.wheel_radius, join(path, "wheel_radius_m"), v, "a wheel radius");
-    else if (s.wheel_radius < 0.0)
-      fail(join(path, "wheel_radius_m"), "must be >= 0, got " + format_double(s.wheel_radius), &v);
+      range(s.wheel_radius, 0.01, 2.0, join(path, "wheel_radius_m"), v, "m (a wheel radius)");
+    else
+      range(s.wheel_radius, 0.0, 2.0, join(path, "wheel_radius_m"), v, "m");
   } else if (s.kind == ModuleKind::kWheel) {
     fail(path, "missing required key 'wheel_radius_m' (every wheel module needs its wheel radius)", &n);
   }
   if (auto v = get(n, "gyro_range_dps"); v.IsDefined()) {
     const std::string p = join(path, "gyro_range_dps");
-    positive(number(v, p), p, v, "a gyro measurement range");
+    range(number(v, p), 10.0, 1e5, p, v, "deg/s (the gyro's full scale)");
     s.gyro_range = number(v, p, kDegU);
+  }
+  if (auto v = get(n, "accel_range_m_s2"); v.IsDefined()) {
+    const std::string p = join(path, "accel_range_m_s2");
+    s.accel_range = number(v, p);
+    range(s.accel_range, 5.0, 1e5, p, v, "m/s^2 (the accelerometer's full scale)");
   }
   if (auto v = get(n, "noise"); v.IsDefined()) noise(v, join(path, "noise"), s.noise);
   return s;
@@ -329,8 +351,7 @@ void Loader::noise(const YAML::Node& n, const std::string& path, ImuNoise& out) 
   for (const auto& k : kNoiseKeys) {
     if (auto v = get(n, k.key); v.IsDefined()) {
       const std::string p = join(path, k.key);
-      const double x = number(v, p);
-      positive(x, p, v, "noise figures and correlation times");
+      range(number(v, p), k.lo, k.hi, p, v, k.unit_name);
       out.*k.member = number(v, p, k.unit);
     }
   }
@@ -479,6 +500,9 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
     if (s.gyro_range > 0.0)
       w.line(4, "gyro_range_dps: " + num(s.gyro_range, kDegU), p + "gyro_range_dps",
              "full scale: readings at it are saturated");
+    if (s.accel_range > 0.0)
+      w.line(4, "accel_range_m_s2: " + num(s.accel_range), p + "accel_range_m_s2",
+             "full scale: readings beyond it are faults");
     w.line(4, "noise:", p + "noise");
     for (const auto& k : kNoiseKeys)
       w.line(6, std::string(k.key) + ": " + num(s.noise.*k.member, k.unit), p + "noise." + k.key);
@@ -499,7 +523,7 @@ void save_manifest(const Manifest& m, const fs::path& file, const ManifestAnnota
     fs::create_directories(file.parent_path(), ec);
     if (ec) throw InputError(quote(file.parent_path()) + ": cannot create directory: " + ec.message());
   }
-  const fs::path tmp = file.string() + ".partial";
+  const fs::path tmp = io_detail::unique_partial(file);
   {
     std::FILE* fp = std::fopen(tmp.c_str(), "wb");
     if (!fp) throw InputError(quote(tmp) + ": cannot create: " + std::strerror(errno));

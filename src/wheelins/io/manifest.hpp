@@ -57,6 +57,9 @@ struct ModuleSpec {
   double wheel_radius = 0.0;    ///< Wheel-IMU nominal wheel radius [m]
   /// Gyro full scale [rad/s] (readings at it are saturated); 0 = not stated.
   double gyro_range = 0.0;
+  /// Accelerometer full scale [m/s^2]; 0 = not stated. A reading beyond either range (+5 %)
+  /// cannot come from the sensor: the run leaves it out as a fault.
+  double accel_range = 0.0;
   ImuNoise noise;
 };
 

@@ -320,12 +320,49 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
   } catch (const YAML::Exception& ex) {
     throw InputError(where + ": " + ex.what());
   }
-  if (!(rate_hz > 0.0) || rate_hz > 10000.0) throw InputError(key("rate_hz") + ": must be in (0, 10000]");
-  if (chips < 1 || chips > 16) throw InputError(key("chips") + ": must be 1..16");
-  if (!(vehicle.wheel_radius > 0.0)) throw InputError(key("vehicle.wheel_radius_m") + ": must be positive");
-  if (duration && !(*duration > 0.0)) throw InputError(key("duration_s") + ": must be positive");
-  if (speed && !(*speed > 0.0)) throw InputError(key("speed_m_s") + ": must be positive");
-  if (laps < 1) throw InputError(key("laps") + ": must be at least 1");
+  // The ranges are checked once every setting is in (validate()): a check here would judge
+  // the settings given so far and blame this YAML (or --set) for another option's value.
+}
+
+void SimConfig::validate() const {
+  auto check = [](double x, double lo, double hi, const char* key, const char* option,
+                  const char* unit, bool lo_open = false) {
+    if (std::isfinite(x) && x <= hi && (lo_open ? x > lo : x >= lo)) return;
+    char range[160];
+    std::snprintf(range, sizeof range, ": must be in %s%g, %g]%s%s, got %g", lo_open ? "(" : "[", lo, hi,
+                  *unit ? " " : "", unit, x);
+    throw InputError(std::string("simulator setting ") + key +
+                     (*option ? std::string(" (") + option + ")" : std::string()) + range);
+  };
+  check(rate_hz, 20.0, 10000.0, "rate_hz", "--rate", "Hz");
+  check(chips, 1, 16, "chips", "--chips", "chips per module");
+  check(laps, 1, 1000, "laps", "--laps", "");
+  if (duration) check(*duration, 0.0, 86400.0, "duration_s", "--duration", "s", true);
+  if (speed) check(*speed, 0.05, 60.0, "speed_m_s", "--cruise-speed", "m/s");
+  check(static_duration, 0.0, 3600.0, "static_s", "--static", "s");
+  check(terrain_slope_deg, 0.0, 30.0, "terrain_slope_deg", "--terrain", "deg");
+  check(vehicle.wheel_radius, 0.01, 2.0, "vehicle.wheel_radius_m", "--radius", "m");
+  check(vehicle.track, 0.05, 10.0, "vehicle.track_m", "--track", "m");
+  if (loop_scale) check(*loop_scale, 0.01, 100.0, "loop_scale", "", "");
+  if (path_sigma) check(*path_sigma, 0.0, 100.0, "path_sigma_m", "", "m");
+  if (speed_sigma) check(*speed_sigma, 0.0, 100.0, "speed_sigma_s", "", "s");
+  if (start_time) check(*start_time, 0.0, 1e9, "start_time_s", "", "s");
+  check(gps_week, 0.0, 1e5, "gps_week", "", "");
+  for (const auto& k : kErrorKeys) {
+    const double x = errors.*k.member;
+    const std::string name = std::string("errors.") + k.key;
+    // Full scales, time constants and the wheel's rolling noise factor need a positive value.
+    const bool positive = name.find("range") != std::string::npos || name.find("tau") != std::string::npos;
+    check(x, 0.0, 1e9, name.c_str(), "", "(SI)", positive);
+  }
+  for (const auto& k : kErrorVecKeys)
+    for (int i = 0; i < 3; ++i)
+      check((errors.*k.member)[i], 0.0, 1e9, (std::string("errors.") + k.key).c_str(), "", "(SI)");
+  for (const double* band : {errors.vib_body_band, errors.vib_wheel_band})
+    if (!(band[0] > 0.0 && band[1] > band[0] && band[1] <= 1e5))
+      throw InputError("simulator setting errors.vibration_*_band_hz: expected 0 < low < high, got [" +
+                       std::to_string(band[0]) + ", " + std::to_string(band[1]) + "]");
+  check(errors.wheel_accel_noise_rest, 0.0, 1.0, "errors.wheel_accel_noise_rest", "", "");
 }
 
 void SimConfig::apply_setting(const std::string& assignment) {

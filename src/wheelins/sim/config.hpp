@@ -146,6 +146,9 @@ struct SimConfig {
   void apply_yaml(const YAML::Node& node, const std::string& where);
   /// Applies "a.b.c=value" (value parsed as YAML).
   void apply_setting(const std::string& assignment);
+  /// Every number in its range (docs/simulator.md); InputError naming the setting and its
+  /// command-line option. The Simulation constructor calls it.
+  void validate() const;
   /// The complete settings as YAML text (the scenario.yaml format).
   std::string to_yaml() const;
 };
