@@ -9,6 +9,7 @@
 #include "wheelins/eval/plots.hpp"
 #include "wheelins/fusion/run_config.hpp"
 #include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/output_dir.hpp"
 #include "wheelins/io/truth.hpp"
 
 namespace {
@@ -36,11 +37,18 @@ void write_file(const fs::path& file, const std::string& text, bool overwrite) {
 int run(const Args& a) {
   fs::path manifest = a.dataset;
   if (fs::is_directory(manifest)) manifest /= "manifest.yaml";
-  const fs::path out = a.out.empty() ? manifest.parent_path() / "experiment" : fs::path(a.out);
+  const fs::path final_out = a.out.empty() ? manifest.parent_path() / "experiment" : fs::path(a.out);
+  if (!(a.duration >= 0.0 && a.duration <= 1e7))
+    throw InputError("--duration " + std::to_string(a.duration) + ": must be in (0, 1e7] s (0: all the data)");
+  // Checked, locked and staged before the runs: a refusal or an unwritable place costs
+  // nothing, and the tables and plots appear together at the end (io/output_dir.hpp).
+  OutputDirOptions out_opt;
+  out_opt.overwrite = a.force;
+  out_opt.kind = "experiment";
+  out_opt.inputs.push_back(manifest);
+  OutputDir out_dir(final_out, out_opt);
+  const fs::path out = out_dir.staging();
   const std::vector<fs::path> files{out / "experiment.md", out / "runs.csv", out / "experiment.json"};
-  for (const auto& f : files) check_output_target(f, a.force);
-  if (!a.no_plots)
-    for (const auto& f : eval::experiment_plot_targets(out)) check_output_target(f, a.force);
 
   eval::ExperimentOptions o;
   o.nav.fusion.speed = speed_sharing_from_name(a.speed);
@@ -63,6 +71,7 @@ int run(const Args& a) {
     const TruthData truth = read_truth(r.truth_file);
     plots = eval::write_experiment_plots(r, truth, earth::LocalFrame(r.origin), out, a.force, o.warn);
   }
+  out_dir.commit();
   std::cout << md;
   std::size_t events = 0, runs_with = 0;
   for (const auto& x : r.runs) {
@@ -71,14 +80,15 @@ int run(const Args& a) {
   }
   std::cout << "fault handling: " << events << " fault events in " << runs_with << " of "
             << r.runs.size() << " runs (runs.csv, column fault_events)\n";
-  for (const auto& f : files) std::cout << "wrote " << f.string() << "\n";
+  auto shown = [&](const fs::path& f) { return (final_out / f.lexically_relative(out)).string(); };
+  for (const auto& f : files) std::cout << "wrote " << shown(f) << "\n";
   std::size_t data_files = 0;
   for (const auto& f : plots) {
     if (f.parent_path().filename() == "data") ++data_files;
-    else std::cout << "wrote " << f.string() << "\n";
+    else std::cout << "wrote " << shown(f) << "\n";
   }
   if (data_files > 0)
-    std::cout << "wrote " << data_files << " plot data files (CSV) in " << (out / "plots" / "data").string()
+    std::cout << "wrote " << data_files << " plot data files (CSV) in " << (final_out / "plots" / "data").string()
               << "\n";
   return 0;
 }

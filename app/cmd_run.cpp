@@ -4,6 +4,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "cli.hpp"
@@ -40,19 +41,45 @@ struct RunArgs {
   bool no_evaluate = false;
   bool force = false;
   bool quiet = false;
-  double duration = 0.0;
-  double output_interval = -1.0;
-  double covariance_interval = -1.0;
+  std::optional<double> duration, output_interval, covariance_interval;
 };
 
+/// A command-line number in its range [lo, hi] (NaN, infinities and 1e400 fail too).
+void check_range(const std::optional<double>& v, const char* option, double lo, double hi,
+                 const char* unit, bool lo_open = false) {
+  if (!v) return;
+  const double x = *v;
+  if (!std::isfinite(x) || x < lo || x > hi || (lo_open && x == lo)) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%s %g: must be in %s%g, %g] %s", option, x, lo_open ? "(" : "[",
+                  lo, hi, unit);
+    throw InputError(buf);
+  }
+}
+
 int run(const RunArgs& a) {
+  check_range(a.duration, "--duration", 0.0, 1e7, "s", true);
+  check_range(a.output_interval, "--output-interval", 0.0, 5.0, "s (0 = every epoch)");
+  check_range(a.covariance_interval, "--covariance-interval", 0.0, 0.5, "s (0 = every epoch)");
+  if (!a.modules.empty() && !a.configuration.empty())
+    throw InputError("--modules and --configuration both given: --modules names the IMUs "
+                     "itself; give one of them");
+  if (!a.modules.empty() && !a.chips.empty())
+    throw InputError("--modules and --chips both given: --chips picks the chips of a "
+                     "--configuration; with --modules name the chips' modules (e.g. left-C2)");
   RunConfig cfg = a.config_file.empty() ? RunConfig{} : load_run_config(a.config_file, stderr_sink());
   if (!a.manifest.empty()) cfg.manifest = a.manifest;
   if (cfg.manifest.empty())
     throw InputError("no dataset: give a run config (wheelins run CONFIG.yaml) or --manifest FILE");
-  if (!a.configuration.empty()) cfg.configuration = a.configuration;
+  if (!a.configuration.empty()) {
+    cfg.configuration = a.configuration;
+    cfg.modules.clear();  // the command line's choice over the config file's modules
+  }
   if (!a.chips.empty()) cfg.chips = split_list(a.chips);
-  if (!a.modules.empty()) cfg.modules = split_list(a.modules);
+  if (!a.modules.empty()) {
+    cfg.modules = split_list(a.modules);
+    if (cfg.modules.empty()) throw InputError("--modules '" + a.modules + "': no module named");
+  }
   if (!a.out.empty()) cfg.output_dir = a.out;
   if (!a.formats.empty()) {
     cfg.formats.clear();
@@ -62,10 +89,10 @@ int run(const RunArgs& a) {
   if (a.centralized) cfg.nav.fusion.centralized = true;
   if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
   if (a.force) cfg.overwrite = true;
-  if (a.duration > 0) cfg.max_duration = a.duration;
+  if (a.duration) cfg.max_duration = *a.duration;
   if (a.no_faults) cfg.nav.faults.enabled = false;
-  if (a.output_interval >= 0) cfg.nav.output_interval = a.output_interval;
-  if (a.covariance_interval >= 0) cfg.nav.covariance_interval = a.covariance_interval;
+  if (a.output_interval) cfg.nav.output_interval = *a.output_interval;
+  if (a.covariance_interval) cfg.nav.covariance_interval = *a.covariance_interval;
 
   RunRequest req = make_run_request(cfg, stderr_sink());
   req.progress = !a.quiet;
@@ -149,14 +176,29 @@ int run(const RunArgs& a) {
     if (!eval_error.empty()) throw InputError(eval_error + " (the trajectory was written)");
     const eval::EvalResult e = evaluator->finish();
     std::printf("\nagainst the truth (%s):\n", truth->file().string().c_str());
+    std::printf("  evaluated           %10.1f s of the %.1f s navigated (%zu truth epochs)\n",
+                e.duration, nav_s, e.epochs);
     std::printf("  distance            %10.1f m\n", e.distance);
-    std::printf("  drift rate          %10.3f %% of distance (l = %.0f m)\n", 100.0 * e.drift_rate,
-                e.segment_length);
+    if (e.drift_curve.empty())
+      std::printf("  drift rate                 n/a (%.1f m travelled, shorter than one l = %.0f m "
+                  "segment)\n", e.distance, e.segment_length);
+    else
+      std::printf("  drift rate          %10.3f %% of distance (l = %.0f m)\n", 100.0 * e.drift_rate,
+                  e.segment_length);
     if (e.has_heading) std::printf("  heading RMSE        %10.3f deg\n", e.heading_rmse / kDeg);
     std::printf("  max / final error   %6.2f / %.2f m\n", e.max_error, e.final_error);
     if (e.has_sigma)
       std::printf("  within 3 sigma      %10.1f %% of epochs (mean NEES %.2f, 2 if consistent)\n",
                   100.0 * e.within_3sigma, e.mean_nees);
+    // The figures hold for the part of the run the truth covers: said when it is not all.
+    if (e.duration < 0.95 * nav_s - 1.0)
+      std::fprintf(stderr,
+                   "warning: %s: the evaluation covers %.1f s (t %.3f .. %.3f) of the %.1f s navigated "
+                   "(%.3f .. %.3f): the truth is shorter than the data, has a gap or a clock jump "
+                   "(%zu truth epochs outside the trajectory, %zu in its gaps); the figures are for "
+                   "that part only\n",
+                   truth->file().string().c_str(), e.duration, e.t_start, e.t_end, nav_s, st.t_start,
+                   st.t_end, e.skipped_outside, e.skipped_gap);
   }
   return 0;
 }
@@ -186,8 +228,7 @@ const bool registered = cli::register_command(
       sub.add_option("--output-interval", a->output_interval, "Output interval [s]; 0 = every epoch");
       sub.add_option("--covariance-interval", a->covariance_interval,
                      "Covariance time update every this many seconds (F integrated in between); "
-                     "0 = every IMU epoch")
-          ->check(CLI::Range(0.0, 0.5));
+                     "0 = every IMU epoch; at most 0.5 s");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line and no option listing");
       return [a]() { return run(*a); };

@@ -9,7 +9,9 @@
 
 #include "cli.hpp"
 #include "wheelins/nav/types.hpp"
+#include "wheelins/io/output_dir.hpp"
 #include "wheelins/io/text_util.hpp"
+#include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/sim/simulator.hpp"
 
 namespace {
@@ -53,7 +55,7 @@ int run(const Options& o) {
   if (!o.config.empty()) {
     YAML::Node node;
     try {
-      node = YAML::LoadFile(o.config);
+      node = load_yaml_file(o.config, "simulator settings");
     } catch (const YAML::Exception& e) {
       throw InputError("'" + o.config + "': " + e.what());
     }
@@ -84,8 +86,20 @@ int run(const Options& o) {
   if (!o.only.empty()) cfg.only(split_commas(o.only));
   cfg.disable(split_commas(o.disable));
 
+  cfg.validate();  // every setting in, so a message names the right option
+  // The dataset appears whole or not at all: written into a staging directory that replaces
+  // the target in one step (io/output_dir.hpp); --force replaces an earlier dataset as a
+  // whole and never one that holds an input of this command.
+  OutputDirOptions out_opt;
+  out_opt.overwrite = o.force;
+  out_opt.kind = "dataset";
+  if (!o.config.empty()) out_opt.inputs.push_back(o.config);
+  if (cfg.scenario != "default") out_opt.inputs.push_back(cfg.scenario);
+  if (cfg.speed_file) out_opt.inputs.push_back(*cfg.speed_file);
+  OutputDir out(o.out, out_opt);
   const sim::Simulation simulation(cfg);
-  const auto sum = simulation.write(o.out, o.force, !o.quiet);
+  const auto sum = simulation.write(out.staging(), false, !o.quiet);
+  out.commit();
   if (!o.quiet) {
     std::printf("scenario  %s\n", sum.scenario.c_str());
     std::printf("profile   %s, seed %llu, effects:", cfg.profile.c_str(),
@@ -122,7 +136,8 @@ const bool registered = wheelins::cli::register_command(
       sub.add_option("--seed", o->seed, "random seed (default 1)");
       sub.add_option("--duration", o->duration, "seconds from the start (default: whole scenario)");
       sub.add_option("--out", o->out, "output dataset directory")->required();
-      sub.add_flag("--force", o->force, "write into a non-empty directory");
+      sub.add_flag("--force", o->force,
+                   "replace an earlier dataset in --out as a whole (never a directory with other files)");
       sub.add_flag("--quiet,-q", o->quiet, "no progress and no summary");
       sub.add_option("--disable", o->disable, "switch effects off (comma list; see docs/simulator.md)");
       sub.add_option("--only", o->only, "switch only these effects on (comma list)");

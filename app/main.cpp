@@ -1,11 +1,13 @@
 // wheelins: multi-IMU wheeled-vehicle dead reckoning (Wheel-INS2).
 #include <algorithm>
+#include <csignal>
 #include <iostream>
 #include <map>
 #include <vector>
 
 #include "cli.hpp"
 #include "wheelins/nav/types.hpp"
+#include "wheelins/util/interrupt.hpp"
 
 namespace wheelins::cli {
 namespace {
@@ -28,8 +30,21 @@ bool register_command(int order, const std::string& name, const std::string& des
 }
 }  // namespace wheelins::cli
 
+namespace {
+extern "C" void on_signal(int sig) {
+  // First signal: ask the work to stop at its next block (outputs are removed, nothing
+  // half-written stays); a second one ends the process at once.
+  if (wheelins::interrupt_requested()) {
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+  }
+  wheelins::request_interrupt();
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace wheelins::cli;
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_signal);
   CLI::App app{"wheelins: dead reckoning for wheeled vehicles from wheel-mounted and body IMUs"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "wheelins 0.1.0");
@@ -43,6 +58,19 @@ int main(int argc, char** argv) {
     runners[sub] = e.setup(*sub);
   }
 
+  // An unknown command is an error, also with --help (which CLI11 would answer with the
+  // main help and exit 0).
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    for (const auto& e : entries) known = known || e.name == argv[1];
+    if (!known) {
+      std::string list;
+      for (const auto& e : entries) list += (list.empty() ? "" : ", ") + e.name;
+      std::cerr << "error: unknown command '" << argv[1] << "' (commands: " << list
+                << "; wheelins --help lists them)\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -52,6 +80,9 @@ int main(int argc, char** argv) {
     if (!sub->parsed()) continue;
     try {
       return run();
+    } catch (const wheelins::Interrupted& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 130;
     } catch (const wheelins::InputError& e) {
       std::cerr << "error: " << e.what() << "\n";
       return 2;

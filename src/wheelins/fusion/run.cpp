@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <set>
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/imu_file.hpp"
+#include "wheelins/io/output_dir.hpp"
 #include "wheelins/io/record_pipe.hpp"
+#include "wheelins/io/text_util.hpp"
+#include "wheelins/util/interrupt.hpp"
 #include "wheelins/util/progress.hpp"
 
 namespace wheelins {
@@ -21,7 +26,262 @@ const char* extension(TrajectoryFormat f) {
   }
 }
 bool multi(const RunRequest& r) { return r.modules.size() > 1 && r.write_subsystems; }
+
+using io_detail::format_double;
+using io_detail::quote;
+
+std::string fmt(double v, const char* f = "%.4g") {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+/// One module's samples as they enter the navigator, with the checks a navigation user
+/// expects of them (docs/faults.md, "Input checks"):
+///  * a sample beyond the sensor range (the manifest's gyro_range_dps / accel_range_m_s2,
+///    else kDefaultGyroLimit / kDefaultAccelLimit) is a fault: left out, its interval given
+///    to the next sample (isolate and continue), or an error without fault handling;
+///  * the records' real rate (median interval of the first ones) matches rate_hz;
+///  * in the static period, the data are increments or rates as declared (the specific force
+///    read both ways), the IMU does not turn, and the specific force is gravity.
+/// A failed check is an InputError naming the file and the figure.
+class CheckedStream final : public ImuStream {
+ public:
+  CheckedStream(std::unique_ptr<ImuFileReader> reader, const ModuleSpec& spec, const Manifest& m,
+                bool isolate, const WarningSink& warn)
+      : reader_(std::move(reader)), spec_(spec), isolate_(isolate), warn_(warn),
+        static_start_(m.static_start), static_end_(m.static_end), gravity_(m.gravity_or_default()),
+        gravity_given_(m.gravity.has_value()) {
+    gyro_limit_ = spec.gyro_range > 0.0 ? 1.05 * spec.gyro_range : kDefaultGyroLimit;
+    accel_limit_ = spec.accel_range > 0.0 ? 1.05 * spec.accel_range : kDefaultAccelLimit;
+  }
+
+  bool next(ImuSample& s) override {
+    while (reader_->next(s)) {
+      check_rate(s);
+      // The format first (from the first static samples, before any is judged by range):
+      // rates read as increments, or the reverse, are off by the rate in every figure.
+      if (!format_checked_) {
+        if (s.t >= static_start_ && s.t <= static_end_) {
+          fmt_sum_ += s.dvel.norm();
+          fmt_time_ += s.dt;
+          if (++fmt_n_ >= 100) check_format();
+        } else if (s.t > static_end_) {
+          check_format();
+        }
+      }
+      const double dt = s.dt;
+      const double w = s.dtheta.cwiseAbs().maxCoeff() / dt, f = s.dvel.cwiseAbs().maxCoeff() / dt;
+      if (!(w <= gyro_limit_) || !(f <= accel_limit_)) {
+        out_of_range(s, w > gyro_limit_);
+        continue;
+      }
+      if (carry_ > 0.0) {  // the samples left out: their interval at this sample's rate
+        const double k = (s.dt + carry_) / s.dt;
+        s.dtheta *= k;
+        s.dvel *= k;
+        s.dt += carry_;
+        carry_ = 0.0;
+      }
+      if (!static_checked_) {
+        if (s.t >= static_start_ && s.t <= static_end_) {
+          sum_dtheta_ += s.dtheta;
+          sum_dvel_ += s.dvel;
+          static_time_ += s.dt;
+          ++static_n_;
+        } else if (s.t > static_end_) {
+          check_static();
+        }
+      }
+      return true;
+    }
+    if (!rate_checked_) finish_rate_check();
+    if (!format_checked_) check_format();
+    if (!static_checked_) check_static();
+    return false;
+  }
+
+  std::uint64_t dropped() const { return dropped_; }
+  const ImuFileReader& reader() const { return *reader_; }
+
+ private:
+  void out_of_range(const ImuSample& s, bool gyro) {
+    const double lim = gyro ? gyro_limit_ : accel_limit_;
+    const Vec3 v = (gyro ? s.dtheta : s.dvel) / s.dt;
+    std::string what = std::string(gyro ? "gyro" : "accelerometer") + " reading " +
+                       fmt(v.cwiseAbs().maxCoeff(), "%.4g") + (gyro ? " rad/s" : " m/s^2") +
+                       " beyond the sensor range " + fmt(lim, "%.4g") + (gyro ? " rad/s" : " m/s^2") +
+                       ((gyro ? spec_.gyro_range : spec_.accel_range) > 0.0
+                            ? std::string(" (the manifest's range + 5 %)")
+                            : std::string(" (no range in the manifest: the physical limit)"));
+    const std::string where = quote(reader_->file()) + ": record " + std::to_string(reader_->index()) +
+                              " (0-based, t=" + format_double(s.t) + "): ";
+    if (!isolate_)
+      throw InputError(where + what + "; with fault handling on, such samples are left out");
+    ++dropped_;
+    carry_ += s.dt;
+    if (first_drop_t_ < 0) first_drop_t_ = s.t;
+    // Reported once the format is known to be right (else that error comes first).
+    if (warn_ && format_checked_ && ++warned_ <= 5)
+      warn_(where + what + ": sample left out (" + spec_.name + ")");
+    else if (warn_ && format_checked_ && warned_ == 6)
+      warn_(quote(reader_->file()) + ": further samples beyond the range are left out and counted");
+  }
+
+  void check_rate(const ImuSample& s) {
+    if (rate_checked_) return;
+    if (n_intervals_++ == 0) return;  // the first sample's dt is the nominal one
+    intervals_.push_back(s.dt);
+    if (intervals_.size() >= 100) finish_rate_check();
+  }
+
+  void finish_rate_check() {
+    rate_checked_ = true;
+    if (intervals_.size() < 10) return;
+    std::nth_element(intervals_.begin(), intervals_.begin() + intervals_.size() / 2, intervals_.end());
+    const double median = intervals_[intervals_.size() / 2];
+    const double real = 1.0 / median;
+    if (real < spec_.rate_hz / 1.25 || real > spec_.rate_hz * 1.25)
+      throw InputError(quote(reader_->file()) + ": the records are " + fmt(median, "%.4g") +
+                       " s apart (median of the first " + std::to_string(intervals_.size()) +
+                       " intervals), i.e. " + fmt(real, "%.4g") + " Hz, but the manifest declares " +
+                       "rate_hz " + format_double(spec_.rate_hz) + " for module '" + spec_.name + "'");
+    intervals_.clear();
+    intervals_.shrink_to_fit();
+  }
+
+  std::string period() const {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "the static period [%.3f, %.3f] s", static_start_, static_end_);
+    return buf;
+  }
+
+  void check_format() {
+    format_checked_ = true;
+    if (fmt_n_ < 10 || !(fmt_time_ > 0.0)) return;  // too short to judge
+    const std::string file = quote(reader_->file());
+    const std::string period = this->period();
+    const double fmag = fmt_sum_ / fmt_time_;  // mean |f| read as declared [m/s^2]
+    const bool rates = spec_.format == SampleFormat::kRate;
+    const double other = rates ? fmag * spec_.rate_hz : fmag / spec_.rate_hz;  // read the other way
+    const double g = gravity_;
+    auto plausible = [&](double x) { return x > 0.5 * g && x < 2.0 * g; };
+    if (!plausible(fmag)) {
+      if (plausible(other))
+        throw InputError(file + ": in " + period + " the accelerometer reads " + fmt(fmag, "%.4g") +
+                         " m/s^2 taken as " + (rates ? "rates" : "increments") + ", " + fmt(other, "%.4g") +
+                         " m/s^2 taken as " + (rates ? "increments" : "rates") + " (gravity " +
+                         fmt(g, "%.4g") + "): the file holds " + (rates ? "increments" : "rates") +
+                         ", the manifest says format: " + to_string(spec_.format) + " (module '" +
+                         spec_.name + "')");
+      throw InputError(file + ": in " + period + " the mean specific force is " + fmt(fmag, "%.4g") +
+                       " m/s^2, far from gravity " + fmt(g, "%.4g") + " m/s^2 (module '" + spec_.name +
+                       "'): wrong units (g instead of m/s^2?), or not a 7-column IMU file");
+    }
+  }
+
+  void check_static() {
+    static_checked_ = true;
+    if (static_n_ < 10 || !(static_time_ > 0.0)) return;  // too short to judge
+    const std::string file = quote(reader_->file());
+    const std::string period = this->period();
+    const double g = gravity_;
+    const double turn = (sum_dtheta_ / static_time_).norm();
+    if (turn > kStaticMaxRate)
+      throw InputError(file + ": the IMU turns at " + fmt(turn / kDeg, "%.3g") + " deg/s on average in " +
+                       period + " (module '" + spec_.name + "'; at rest it reads the earth rate and "
+                       "its bias, well under " + fmt(kStaticMaxRate / kDeg, "%.3g") +
+                       " deg/s): the vehicle moves there; move static_period_s to where it stands");
+    const double fmean = (sum_dvel_ / static_time_).norm();
+    if (std::abs(fmean - g) > kGravityTolerance * g)
+      throw InputError(file + ": the mean specific force in " + period + " is " + fmt(fmean, "%.4g") +
+                       " m/s^2, gravity " + (gravity_given_ ? "(gravity_m_s2 of the manifest) " : "at the origin ") +
+                       fmt(g, "%.4g") + " m/s^2, " + fmt(100.0 * std::abs(fmean - g) / g, "%.2g") +
+                       " % apart (module '" + spec_.name + "'): the vehicle accelerates or shakes "
+                       "there, or gravity_m_s2 / the accelerometer scale is wrong");
+  }
+
+ public:
+  static constexpr double kDefaultGyroLimit = 20000.0 * kDeg;  ///< [rad/s] no range declared
+  static constexpr double kDefaultAccelLimit = 2000.0;         ///< [m/s^2] about 200 g
+  static constexpr double kStaticMaxRate = 5.0 * kDeg;         ///< mean rate at rest [rad/s]
+  static constexpr double kGravityTolerance = 0.05;            ///< |f| at rest vs gravity
+
+ private:
+  std::unique_ptr<ImuFileReader> reader_;
+  const ModuleSpec& spec_;
+  bool isolate_;
+  WarningSink warn_;
+  double gyro_limit_ = 0.0, accel_limit_ = 0.0;
+  double carry_ = 0.0, first_drop_t_ = -1.0;
+  std::uint64_t dropped_ = 0;
+  std::uint64_t n_intervals_ = 0;
+  std::vector<double> intervals_;
+  bool rate_checked_ = false;
+  double static_start_, static_end_, gravity_;
+  bool gravity_given_;
+  bool static_checked_ = false;
+  bool format_checked_ = false;
+  double fmt_sum_ = 0.0, fmt_time_ = 0.0;
+  std::uint64_t fmt_n_ = 0, warned_ = 0;
+  Vec3 sum_dtheta_ = Vec3::Zero(), sum_dvel_ = Vec3::Zero();
+  double static_time_ = 0.0;
+  std::uint64_t static_n_ = 0;
+};
+
+bool finite(const TrajectoryRecord& r) {
+  return std::isfinite(r.t) && r.p_inN.allFinite() && r.v_inN.allFinite() && r.rpy.allFinite() &&
+         r.p_std.allFinite() && r.v_std.allFinite() && r.rpy_std.allFinite();
+}
+
 }  // namespace
+
+void validate_run_request(const RunRequest& r) {
+  const std::string man = quote(r.manifest.path);
+  if (r.modules.empty()) throw InputError("no module selected");
+  std::set<std::string> seen;
+  for (const auto& m : r.modules) {
+    if (!seen.insert(m).second)
+      throw InputError("module '" + m + "' is listed twice; each module can be used once in a run");
+    if (!r.manifest.find(m)) throw InputError(man + ": no module named '" + m + "'");
+  }
+  std::set<TrajectoryFormat> formats;
+  for (TrajectoryFormat f : r.formats)
+    if (!formats.insert(f).second)
+      throw InputError(std::string("output format '") + extension(f) + "' is listed twice");
+  if (!(r.max_duration >= 0.0 && r.max_duration <= 1e7))
+    throw InputError("duration: must be in (0, 1e7] s (0: all the data), got " + format_double(r.max_duration));
+  const NavigatorOptions& n = r.nav;
+  if (!(n.output_interval >= 0.0 && n.output_interval <= 5.0))
+    throw InputError("output interval: must be in [0, 5] s (0 = every epoch; the evaluation "
+                     "interpolates across at most 5 s), got " + format_double(n.output_interval));
+  if (!(n.covariance_interval >= 0.0 && n.covariance_interval <= 0.5))
+    throw InputError("covariance interval: must be in [0, 0.5] s, got " + format_double(n.covariance_interval));
+  if (n.fusion.centralized && r.modules.size() < 2)
+    throw InputError("the centralized filter joins several IMUs; a run of one module ('" +
+                     r.modules.front() + "') has nothing to join (drop --centralized / "
+                     "fusion.centralized, or choose a multi-IMU configuration)");
+  if (!n.fusion.weights.empty()) {
+    if (n.fusion.weights.size() != r.modules.size())
+      throw InputError("fusion weights: " + std::to_string(n.fusion.weights.size()) + " given for " +
+                       std::to_string(r.modules.size()) + " modules");
+    for (double w : n.fusion.weights)
+      if (!(w > 0.0 && w <= 1e6))
+        throw InputError("fusion weights: must be in (0, 1e6], got " + format_double(w) +
+                         " (leave a module out instead of weighting it 0)");
+  }
+  if (n.faults.enabled)
+    for (const auto& name : r.modules) {
+      const ModuleSpec& s = *r.manifest.find(name);
+      if (1.5 / s.rate_hz >= n.faults.max_gap)
+        throw InputError(man + ": module '" + name + "' is declared at " + format_double(s.rate_hz) +
+                         " Hz: its sample interval " + fmt(1.0 / s.rate_hz, "%.4g") +
+                         " s is too close to faults.max_gap_s " + format_double(n.faults.max_gap) +
+                         " s, so its samples would be taken for gaps (the module restarted on each); "
+                         "IMU data above " + fmt(1.5 / n.faults.max_gap, "%.3g") +
+                         " Hz are needed, or a larger faults.max_gap_s");
+    }
+}
 
 std::vector<fs::path> run_output_files(const RunRequest& r) {
   std::vector<fs::path> files;
@@ -35,36 +295,49 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
 
 RunResult run_navigation(const RunRequest& r) {
   const auto wall0 = std::chrono::steady_clock::now();
-  // Refuse before doing any work if results would be overwritten.
+  validate_run_request(r);
+  // The output directory appears complete or not at all (io/output_dir.hpp); it is checked,
+  // locked and staged before any work, so a refusal or an unwritable place costs nothing.
   const std::vector<fs::path> outputs = run_output_files(r);
-  for (const auto& f : outputs) check_output_target(f, r.overwrite);
+  std::unique_ptr<OutputDir> out_dir;
+  if (!r.output_dir.empty()) {
+    OutputDirOptions o;
+    o.overwrite = r.overwrite;
+    o.kind = "results";
+    o.inputs.push_back(r.manifest.path);
+    for (const auto& name : r.modules) o.inputs.push_back(r.manifest.resolve(r.manifest.find(name)->file));
+    if (r.manifest.truth_file) o.inputs.push_back(r.manifest.resolve(*r.manifest.truth_file));
+    out_dir = std::make_unique<OutputDir>(r.output_dir, o);
+  }
+  auto staged = [&](const fs::path& final_file) { return out_dir->staging() / final_file.filename(); };
 
-  // Readers for the selected modules only, merged by time.
+  // Readers for the selected modules only, merged by time; each through the input checks.
   std::vector<std::unique_ptr<ImuStream>> readers;
+  std::vector<CheckedStream*> checked;
   std::uint64_t total_rows = 0;
   for (const auto& name : r.modules) {
     const ModuleSpec* spec = r.manifest.find(name);
-    if (!spec) throw InputError("'" + r.manifest.path.string() + "': no module named '" + name + "'");
     const fs::path file = r.manifest.resolve(spec->file);
-    readers.push_back(std::make_unique<ImuFileReader>(file, imu_read_options(*spec, r.warn)));
+    auto reader = std::make_unique<ImuFileReader>(file, imu_read_options(*spec, r.warn));
+    auto c = std::make_unique<CheckedStream>(std::move(reader), *spec, r.manifest, r.nav.faults.enabled, r.warn);
+    checked.push_back(c.get());
+    readers.push_back(std::move(c));
     std::error_code ec;
     if (spec->layout == FileLayout::kBinary) total_rows += fs::file_size(file, ec) / (7 * sizeof(double));
   }
   ImuMerger merger(std::move(readers));
 
   // Writers: the vehicle solution in every format, the subsystems as CSV.
-  if (!r.output_dir.empty()) fs::create_directories(r.output_dir);
   TrajectoryWriterOptions wopt;
-  wopt.overwrite = r.overwrite;
   std::vector<std::unique_ptr<TrajectoryWriter>> vehicle, subsystems;
-  if (!r.output_dir.empty()) {
+  if (out_dir) {
     for (TrajectoryFormat f : r.formats)
       vehicle.push_back(make_trajectory_writer(
-          f, r.output_dir / (std::string("trajectory") + extension(f)), wopt));
+          f, out_dir->staging() / (std::string("trajectory") + extension(f)), wopt));
     if (multi(r))
       for (const auto& m : r.modules)
         subsystems.push_back(
-            make_trajectory_writer(TrajectoryFormat::kCsv, r.output_dir / (m + ".csv"), wopt));
+            make_trajectory_writer(TrajectoryFormat::kCsv, out_dir->staging() / (m + ".csv"), wopt));
   }
 
   // Text formatting and file writing run on a second thread (RecordPipe), fed in batches;
@@ -83,14 +356,46 @@ RunResult run_navigation(const RunRequest& r) {
   nav_opt.module_records = !subsystems.empty();  // only when their files are written
   // What the records are used for (the caller's consumer, e.g. the streaming evaluation,
   // and the hand-over to the writer thread, which waits when the writer is behind) is
-  // timed here and left out of filter_seconds.
+  // timed here and left out of filter_seconds. A record that is not finite is never
+  // passed on: the run stops at the end of the block with the module, time and cause.
   double sink_seconds = 0.0;
+  int bad_stream = -1;
+  double bad_t = 0.0;
   Navigator nav(r.manifest, r.modules, nav_opt, [&](int stream, const TrajectoryRecord& rec) {
+    if (bad_stream >= 0) return;
+    if (!finite(rec)) {
+      bad_stream = stream;
+      bad_t = rec.t;
+      return;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     if (stream == 0 && r.on_record) r.on_record(rec);
     if (pipe) pipe->push(stream, rec);
     sink_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   });
+  // Where the solution stopped being finite: the first subsystem whose state or covariance
+  // is not, else the stream of the record.
+  auto check_finite = [&](double t_now) {
+    std::string module, cause;
+    for (int i = 0; i < nav.subsystem_count() && module.empty(); ++i) {
+      const StrapdownEkf& ekf = nav.subsystem(i).ekf();
+      const NavState& x = ekf.state();
+      if (!(x.p_IinW.allFinite() && x.v_IinW.allFinite() && x.q_ItoW.coeffs().allFinite()))
+        module = r.modules[static_cast<std::size_t>(i)], cause = "its position, velocity or attitude";
+      else if (!ekf.covariance().allFinite())
+        module = r.modules[static_cast<std::size_t>(i)], cause = "its covariance";
+    }
+    if (module.empty() && bad_stream < 0) return;
+    if (module.empty()) {
+      module = bad_stream == 0 ? std::string("the vehicle solution") : r.modules[static_cast<std::size_t>(bad_stream - 1)];
+      cause = "its output record";
+    }
+    const double t = bad_stream >= 0 ? bad_t : t_now;
+    throw InputError("'" + module + "': the navigation became non-finite (" + cause + ") by t = " +
+                     format_double(t) + " s, " + fmt(t - nav.stats().t_start, "%.1f") +
+                     " s after the start: the filter diverged (an input or a setting outside what "
+                     "the checks catch); nothing was written");
+  };
 
   Progress progress("navigating", total_rows, r.progress);
   // Samples are read in blocks, and only the processing of a block is timed: the
@@ -114,7 +419,8 @@ RunResult run_navigation(const RunRequest& r) {
     }
     filter_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     n += count;
-    progress.update(n);
+    if (count) check_finite(block[count - 1].second.t);
+    progress.update(n);  // also where an interrupt stops the run (nothing is written)
   }
   progress.finish();
   if (!nav.navigating()) {
@@ -129,18 +435,34 @@ RunResult run_navigation(const RunRequest& r) {
   }
 
   nav.finish();
+  check_finite(nav.stats().t_end);
   if (pipe) pipe->finish();  // every record written (or the writer's error thrown)
   RunResult result;
   for (auto& w : vehicle) w->commit();
   for (auto& w : subsystems) w->commit();
-  if (!r.output_dir.empty()) {
-    AtomicTextFile report(r.output_dir / "faults.csv", r.overwrite);
-    report.write(fault_report_csv(nav.faults()));
+  std::string input_faults;
+  for (std::size_t i = 0; i < checked.size(); ++i)
+    if (checked[i]->dropped())
+      input_faults += "  " + r.modules[i] + ": " + std::to_string(checked[i]->dropped()) +
+                      " samples beyond the sensor range left out (" + quote(checked[i]->reader().file()) + ")\n";
+  if (out_dir) {
+    std::string csv = fault_report_csv(nav.faults());
+    for (std::size_t i = 0; i < checked.size(); ++i)
+      if (checked[i]->dropped())
+        csv += "# input: " + r.modules[i] + ",samples_beyond_range," + std::to_string(checked[i]->dropped()) + "\n";
+    AtomicTextFile report(staged(r.output_dir / "faults.csv"), false);
+    report.write(csv);
     report.commit();
+    out_dir->commit();  // every file appears at once
   }
   result.fault_report = fault_report_text(nav.faults());
+  if (!input_faults.empty()) {
+    if (result.fault_report.rfind("faults: none detected", 0) == 0) result.fault_report = "faults:\n" + result.fault_report.substr(22);
+    result.fault_report = "input faults:\n" + input_faults + result.fault_report;
+  }
   result.fault_events = nav.faults().events();
   result.files = outputs;
+  for (auto& f : result.files) f = out_dir ? out_dir->final_path(f.filename()) : f;
   result.stats = nav.stats();
   result.filter_seconds = std::max(0.0, filter_seconds - sink_seconds);
   result.wall_seconds =

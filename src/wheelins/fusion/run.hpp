@@ -38,7 +38,14 @@ struct RunResult {
   std::vector<FaultEvent> fault_events;      ///< every detection and what was done
 };
 
+/// Runs the request. The output directory is written through OutputDir: checked, locked
+/// and staged before any work, its files appear together at the end (or not at all).
 RunResult run_navigation(const RunRequest& request);
+
+/// The checks of a request before any work (InputError naming what is wrong): modules
+/// known and listed once, formats listed once, the numbers in their ranges, the
+/// centralized filter on several modules, every module's rate above the gap threshold.
+void validate_run_request(const RunRequest& request);
 
 /// The files a run would write (to refuse early, before any work, if they exist).
 std::vector<std::filesystem::path> run_output_files(const RunRequest& request);

@@ -15,6 +15,7 @@
 #include "wheelins/io/truth.hpp"
 #include "wheelins/nav/types.hpp"
 #include "wheelins/sim/faults.hpp"
+#include "wheelins/util/interrupt.hpp"
 #include "wheelins/util/progress.hpp"
 
 namespace wheelins::sim {
@@ -392,6 +393,7 @@ const char* Simulation::group_dir(int g) {
 }
 
 Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
+  cfg_.validate();
   const bool car = cfg_.vehicle.preset == "car";
   Terrain terrain;
   if (cfg_.terrain_slope_deg > 0.0) terrain = Terrain::gentle(cfg_.terrain_slope_deg, cfg_.seed);
@@ -1034,7 +1036,10 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
             bias_outs[c]->write(row);
           }
         }
-        if ((k & 255) == 0) done += 256;
+        if ((k & 255) == 0) {
+          done += 256;
+          check_interrupt();  // Ctrl-C: stop here too, not only in the progress thread
+        }
       }
       if (ideal_out) ideal_out->commit();
       for (auto& o : outs) o->commit();

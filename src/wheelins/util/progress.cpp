@@ -1,5 +1,7 @@
 #include "wheelins/util/progress.hpp"
 
+#include "wheelins/util/interrupt.hpp"
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -16,6 +18,7 @@ Progress::Progress(std::string label, std::uint64_t total, bool enabled)
 Progress::~Progress() { finish(); }
 
 void Progress::update(std::uint64_t done) {
+  check_interrupt();  // every long loop reports progress: it stops here on Ctrl-C / kill
   if (!enabled_ || finished_) return;
   const auto now = std::chrono::steady_clock::now();
   if (now - last_ < std::chrono::milliseconds(100)) return;

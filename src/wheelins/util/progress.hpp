@@ -13,7 +13,8 @@ class Progress {
   /// `total` is the amount of work (samples, bytes, runs); 0 if unknown.
   Progress(std::string label, std::uint64_t total, bool enabled = true);
   ~Progress();
-  /// Reports that `done` units are complete; redraws at most ~10 times a second.
+  /// Reports that `done` units are complete; redraws at most ~10 times a second. Throws
+  /// Interrupted when an interrupt was requested (util/interrupt.hpp).
   void update(std::uint64_t done);
   void finish();
 
