@@ -27,6 +27,11 @@ int run(const Options& o) {
   for (const auto& f : d.facts) std::cout << "  " << f << "\n";
   std::cout << "still to fill in (marked TODO in the file):\n";
   for (const auto& t : d.todo) std::cout << "  - " << t << "\n";
+  if (!d.todo.empty())
+    std::cerr << "warning: " << out.string() << ": " << d.todo.size()
+              << " entries are placeholders (typical values, marked TODO), not measurements of "
+              << "your vehicle; `wheelins run` navigates with them as they are, and the results "
+              << "are only as good as they are\n";
   return 0;
 }
 
@@ -35,7 +40,8 @@ const bool registered = wheelins::cli::register_command(
     [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
       sub.add_option("DIR", o->dir,
-                     "directory with <name>_imu.bin + GINS.bin (single IMU), or body-imu/, "
+                     "directory with <name>_imu.bin + GINS.bin (single IMU); Wheel-IMU/, Body-IMU/, "
+                     "'Ground Truth'/, Odometer/ (the public Wheel-INS layout); or body-imu/, "
                      "left-wheel-imu/, right-wheel-imu/ + ground_truth/ (multi-IMU)")
           ->required();
       sub.add_option("-o,--output", o->out, "manifest file to write (default: DIR/manifest.yaml)");

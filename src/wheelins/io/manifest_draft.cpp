@@ -1,6 +1,7 @@
 #include "wheelins/io/manifest_draft.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -188,6 +189,54 @@ std::vector<Found> find_single(const fs::path& dir) {
   return out;
 }
 
+/// A folder name as the public dataset spells it, compared without case, blanks, '-' and '_'
+/// ("Wheel-IMU", "wheel_imu", "Ground Truth", "ground_truth").
+std::string folder_key(const std::string& name) {
+  std::string k;
+  for (unsigned char c : name)
+    if (c != '-' && c != '_' && c != ' ') k += static_cast<char>(std::tolower(c));
+  return k;
+}
+
+/// The subfolder of `dir` whose folder_key() is `key` (empty if none).
+fs::path subfolder(const fs::path& dir, const std::string& key) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.is_directory(ec) && folder_key(e.path().filename().string()) == key) return e.path();
+  return {};
+}
+
+/// The public Wheel-INS layout: Wheel-IMU/<chip>_imu.bin, Body-IMU/<chip>_imu.bin,
+/// Ground Truth/GINS.bin, Odometer/odo.bin (a Body/Wheel pair).
+std::vector<Found> find_public(const fs::path& dir) {
+  std::vector<Found> out;
+  const struct {
+    const char* key;
+    const char* prefix;
+    const char* group;
+    ModuleKind kind;
+  } groups[] = {{"wheelimu", "wheel", "wheel", ModuleKind::kWheel},
+                {"bodyimu", "body", "body", ModuleKind::kBody}};
+  for (const auto& g : groups) {
+    const fs::path sub = subfolder(dir, g.key);
+    if (sub.empty()) continue;
+    std::vector<Found> here;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(sub, ec)) {
+      const std::string fname = e.path().filename().string();
+      const std::string suffix = "_imu.bin";
+      if (!e.is_regular_file(ec) || fname.size() <= suffix.size() ||
+          fname.compare(fname.size() - suffix.size(), suffix.size(), suffix) != 0)
+        continue;
+      const std::string chip = fname.substr(0, fname.size() - suffix.size());
+      here.push_back({std::string(g.prefix) + "-" + chip, g.group, chip, g.kind, e.path()});
+    }
+    std::sort(here.begin(), here.end(), [](const Found& a, const Found& b) { return a.file < b.file; });
+    out.insert(out.end(), here.begin(), here.end());
+  }
+  return out;
+}
+
 }  // namespace
 
 ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_file) {
@@ -206,7 +255,20 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
 
   std::vector<Found> found = find_multi(dir);
   fs::path truth;
-  if (!found.empty()) {
+  fs::path odo = dir / "odo.bin";
+  const std::vector<Found> pub = found.empty() ? find_public(dir) : std::vector<Found>{};
+  if (!pub.empty()) {
+    found = pub;
+    d.layout = "public Wheel-INS";
+    const fs::path gt = subfolder(dir, "groundtruth");
+    for (const fs::path& t : {gt.empty() ? fs::path() : gt / "GINS.bin", dir / "GINS.bin"})
+      if (!t.empty() && fs::is_regular_file(t)) {
+        truth = t;
+        break;
+      }
+    const fs::path od = subfolder(dir, "odometer");
+    if (!od.empty() && fs::is_regular_file(od / "odo.bin")) odo = od / "odo.bin";
+  } else if (!found.empty()) {
     d.layout = "multi-IMU";
     for (const fs::path& t : {dir / "ground_truth" / "GINS-body.bin", dir / "GINS-body.bin", dir / "GINS.bin"})
       if (fs::is_regular_file(t)) {
@@ -217,13 +279,13 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
     found = find_single(dir);
     if (found.empty())
       throw InputError(quote(dir_in) +
-                       ": no recordings found; expected either <name>_imu.bin (+ GINS.bin, odo.bin) "
-                       "or body-imu/, left-wheel-imu/, right-wheel-imu/ with tri_C1_imu.bin ... "
-                       "tri_C4_imu.bin (+ ground_truth/GINS-body.bin)");
+                       ": no recordings found; expected <name>_imu.bin (+ GINS.bin, odo.bin), "
+                       "or Wheel-IMU/ and Body-IMU/ with <chip>_imu.bin (+ 'Ground Truth'/GINS.bin, "
+                       "Odometer/odo.bin: the public Wheel-INS layout), or body-imu/, left-wheel-imu/, "
+                       "right-wheel-imu/ with tri_C1_imu.bin ... tri_C4_imu.bin (+ ground_truth/GINS-body.bin)");
     d.layout = "single-IMU";
     if (fs::is_regular_file(dir / "GINS.bin")) truth = dir / "GINS.bin";
   }
-  const fs::path odo = dir / "odo.bin";
   const bool has_odo = fs::is_regular_file(odo);
 
   // Modules: files, rates, start times.
@@ -264,6 +326,14 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
       note[key + "mounting_deg"] = kTodo;
       note[key + "axle_sign"] = std::string(kTodo) + " (+1: sensor x-axis points to the vehicle's right)";
       if (found.size() == 1) note[key + "kind"] = "TODO: check (the public Wheel-INS IMU is on a wheel)";
+      if (!left && !right) {
+        // Which wheel the data cannot tell: on the vehicle's centre line (y = 0), which every
+        // configuration with one wheel accepts as its wheel; the side only matters with two.
+        note[key + "position_v_m"] = std::string(kTodo) +
+                                     " (wheel centre in the v-frame; y < 0 left wheel, y > 0 right; "
+                                     "y = 0: side unknown)";
+        d.todo.push_back(f.name + ": position_v_m (which wheel: y = 0 written)");
+      }
     } else {
       note[key + "position_v_m"] = std::string(kTodo) + " (IMU centre in the v-frame)";
       note[key + "mounting_deg"] = std::string(kTodo) + " (C_b^v as roll, pitch, yaw)";
