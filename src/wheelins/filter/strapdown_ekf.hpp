@@ -77,7 +77,10 @@ class StrapdownEkf {
   /// The last sample compensated with the current error estimates, as rates [rad/s],
   /// [m/s^2] (after a feedback, the corrected estimates apply: measurement models evaluated
   /// between two epochs, e.g. a centralized filter's sequential updates, stay consistent).
-  Vec3 omega_ib_b() const { return compensate(last_raw_, errors_).dtheta / last_raw_.dt; }
+  /// Zero before the first epoch (no sample yet: 0 / 0 gave the first record a NaN velocity).
+  Vec3 omega_ib_b() const {
+    return last_raw_.dt > 0.0 ? Vec3(compensate(last_raw_, errors_).dtheta / last_raw_.dt) : Vec3::Zero();
+  }
   Vec3 f_b() const { return last_.dvel / last_.dt; }
   const ImuSample& last_compensated() const { return last_; }
   const MechanizationOptions& mechanization() const { return mech_; }
