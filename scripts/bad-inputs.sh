@@ -10,6 +10,11 @@ S=${2:-$(mktemp -d)}
 mkdir -p "$S"
 "$W" simulate --out "$S/ok" --profile datasheet --duration 45 --chips 1 --no-ideal -q >/dev/null || exit 1
 IMU="left-wheel-imu/tri_C1_imu.bin"
+# Resource limits for every case: a runaway (endless output, memory growing until
+# bad_alloc, a hang) shows as exit 124 (timeout) or a memory error instead of filling
+# the machine.
+LIMIT_S=${LIMIT_S:-60}
+LIMIT_KB=${LIMIT_KB:-2000000}
 
 # A copy of the dataset whose manifest is edited by sed expression $2 and whose left IMU
 # file is replaced by the output of python snippet $3 (reading the original as `rows`).
@@ -37,12 +42,14 @@ echo "|---|---|---|"
 case_() {  # description, command...
   local what=$1; shift
   local out rc
-  out=$("$@" 2>&1 >/dev/null); rc=$?
-  out=$(printf '%s\n' "$out" | grep -E "error|warning" | head -1)
+  out=$( (ulimit -v "$LIMIT_KB" -f 2000000; timeout -k 5 "$LIMIT_S" bash -c '"$@"' _ "$@") 2>&1 >/dev/null); rc=$?
+  out=$(printf '%s\n' "$out" | grep -E "error|warning|Error|what\(\)" | head -1)
+  [ $rc = 124 ] && out="(killed after $LIMIT_S s) $out"
   out=${out//$S\//}
   echo "| $what | $rc | ${out//|/\\|} |"
 }
 run() { "$W" run -m "$1/manifest.yaml" -c single -q -o "$1/out" --formats csv; }
+export W S; export -f run
 
 d=$(variant missing-file 's#tri_C1_imu.bin#tri_C9_imu.bin#'); case_ "IMU file missing" run "$d"
 d=$(variant dir-as-file 's#tri_C1_imu.bin#somedir#'); mkdir -p "$d/left-wheel-imu/somedir"; case_ "a directory where the IMU file should be" run "$d"
@@ -82,3 +89,156 @@ case_ "unknown configuration" "$W" run -m "$S/ok/manifest.yaml" -c quadruple -q
 "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/ok/out2" --formats csv >/dev/null 2>&1
 case_ "results already there (not overwritten)" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/ok/out2" --formats csv
 case_ "bad --fault spec for simulate" "$W" simulate --out "$S/f" --fault slip:body:3:5:ratio=1 -q
+
+# ---------------------------------------------------------------------------------------
+# Hardening cases: each says what a good answer is; exit 0 only where the run may go on
+# (a fault isolated, a warning).
+echo "| **silent wrong answers** | | |"
+T="$S/tri"
+"$W" simulate --out "$T" --profile datasheet --duration 150 --chips 1 --no-ideal -q >/dev/null || exit 1
+trirun() { "$W" run "$@" -q --formats csv; }
+export -f trirun
+printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: [1, 0, 0]}\noutput: {dir: w100}\n' > "$S/run-w100.yaml"
+case_ "fusion weights [1, 0, 0] (error: every module needs a positive weight)" trirun "$S/run-w100.yaml"
+printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: [0, 0, 0]}\noutput: {dir: w000}\n' > "$S/run-w000.yaml"
+case_ "fusion weights [0, 0, 0]" trirun "$S/run-w000.yaml"
+tri_variant() {  # name, python on the rows of the right Wheel-IMU file
+  local d="$S/$1"; rm -rf "$d"; cp -r "$T" "$d"
+  python3 - "$d/right-wheel-imu/tri_C1_imu.bin" <<EOF
+import struct, sys
+p = sys.argv[1]
+b = open(p, 'rb').read()
+rows = [list(struct.unpack_from('7d', b, 56 * k)) for k in range(len(b) // 56)]
+$2
+open(p, "wb").write(b"".join(struct.pack("7d", *r) for r in rows))
+EOF
+  echo "$d"
+}
+d=$(tri_variant spike300 'rows[9000][5] = 1e300'); case_ "one accel sample of 1e300 in one chip, triple (isolated, the run goes on, no NaN)" trirun -m "$d/manifest.yaml" -c triple -o "$d/out"
+d=$(tri_variant spike6 'rows[9000][2] = 1e6'); case_ "one gyro sample of 1e6 rad/s in one chip, triple" trirun -m "$d/manifest.yaml" -c triple -o "$d/out"
+case_ "the same with --no-fault-handling (a clear error)" trirun -m "$d/manifest.yaml" -c triple -o "$d/out2" --no-fault-handling
+d=$(variant tau-tiny 's#gyro_bias_tau_h: .*#gyro_bias_tau_h: 1e-6#'); case_ "gyro_bias_tau_h: 1e-6 (out of range)" run "$d"
+d=$(variant arw-huge 's#gyro_arw_deg_sqrt_h: .*#gyro_arw_deg_sqrt_h: 1e300#'); case_ "gyro_arw_deg_sqrt_h: 1e300" run "$d"
+d=$(variant radius-tiny 's#wheel_radius_m: .*#wheel_radius_m: 1e-9#'); case_ "wheel radius 1e-9 m" run "$d"
+d=$(variant radius-huge 's#wheel_radius_m: .*#wheel_radius_m: 40#'); case_ "wheel radius 40 m" run "$d"
+d=$(variant gravity 's#^gravity_m_s2: .*#gravity_m_s2: 4.9#'); case_ "gravity_m_s2: 4.9" run "$d"
+d=$(variant moving-static 's#^static_period_s: .*#static_period_s: [100040, 100044]#'); case_ "static period placed while the vehicle moves" run "$d"
+d=$(variant as-increments 's#format: rate#format: increment#'); case_ "a rate file declared as increments" run "$d"
+d=$(variant as-rates '' "$put
+put([[r[0]] + [x * 0.005 for x in r[1:]] for r in rows])"); case_ "an increment file declared as rates" run "$d"
+d=$(variant rate-wrong 's#rate_hz: 200#rate_hz: 100#'); case_ "declared 100 Hz, data at 200 Hz" run "$d"
+d=$(variant rate-20 's#rate_hz: 200#rate_hz: 20#' "$put
+put([r for k, r in enumerate(rows) if k % 10 == 0])"); case_ "a module at 20 Hz (was restarted on every sample)" run "$d"
+case_ "--output-interval 1e9" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/oi" --formats csv --output-interval 1e9
+case_ "a run shorter than one 100 m segment (drift rate n/a; exit 0)" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/short" --formats csv --duration 20
+d=$(variant truth-short ''); python3 - "$d/GINS.bin" <<'EOF'
+import sys; p = sys.argv[1]; b = open(p, 'rb').read(); open(p, 'wb').write(b[:len(b) * 8 // 9 // 88 * 88])
+EOF
+case_ "truth shorter than the data (a warning: the evaluation covers part)" run "$d"
+d=$(variant truth-jump ''); python3 - "$d/GINS.bin" <<'EOF'
+import struct, sys; p = sys.argv[1]; b = bytearray(open(p, 'rb').read()); n = len(b) // 88
+for k in range(n * 8 // 9, n): struct.pack_into('d', b, 88 * k + 8, struct.unpack_from('d', b, 88 * k + 8)[0] + 3600.0)
+open(p, 'wb').write(bytes(b))
+EOF
+case_ "truth with a 1 h clock jump" run "$d"
+d=$(variant traj-nan ''); "$W" run -m "$d/manifest.yaml" -c single -q -o "$d/out" --formats csv >/dev/null 2>&1
+python3 - "$d/out/trajectory.csv" <<'EOF'
+import sys; p = sys.argv[1]; L = open(p).read().split('\n'); f = L[500].split(','); f[1] = 'nan'; L[500] = ','.join(f); open(p, 'w').write('\n'.join(L))
+EOF
+case_ "evaluate: a trajectory with a NaN" "$W" evaluate --truth "$d/GINS.bin" --traj "$d/out/trajectory.csv"
+
+echo "| **runaway work, unbounded memory** | | |"
+case_ "simulate --duration -10" "$W" simulate --out "$S/sd1" --duration -10 -q
+case_ "simulate --duration -10 --set chips=2 (names --duration)" "$W" simulate --out "$S/sd2" --duration -10 --set chips=2 -q
+case_ "simulate --duration 1e9" "$W" simulate --out "$S/sd3" --duration 1e9 -q
+case_ "simulate --cruise-speed 1e-5" "$W" simulate --out "$S/sc1" --cruise-speed 1e-5 -q
+case_ "simulate --cruise-speed -1" "$W" simulate --out "$S/sc2" --cruise-speed -1 -q
+case_ "simulate --rate 1e-3" "$W" simulate --out "$S/sr" --rate 1e-3 -q
+case_ "simulate --laps 1000000" "$W" simulate --out "$S/sl" --laps 1000000 -q
+case_ "evaluate --segment 1e-9" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/ok/out2/trajectory.csv" --segment 1e-9
+case_ "evaluate --max-gap -1" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/ok/out2/trajectory.csv" --max-gap -1
+case_ "/dev/zero as the manifest" "$W" run -m /dev/zero -q -o "$S/z1"
+case_ "/dev/zero as the run config" "$W" run /dev/zero -q
+d=$(variant text-zero 's#layout: binary#layout: text#; s#tri_C1_imu.bin#zero.txt#'); ln -sf /dev/zero "$d/left-wheel-imu/zero.txt"; case_ "/dev/zero as a text IMU file" run "$d"
+d=$(variant text-zeros 's#layout: binary#layout: text#; s#tri_C1_imu.bin#zeros.txt#'); head -c 50000000 /dev/zero > "$d/left-wheel-imu/zeros.txt"; case_ "50 MB of zero bytes as a text IMU file (no newline)" run "$d"
+d=$(variant many-keys ''); python3 - "$d/manifest.yaml" 1000000 <<'EOF'
+import sys; p = sys.argv[1]; n = int(sys.argv[2]); s = open(p).read()
+open(p, 'w').write(s + ''.join('unknown_%d: 1\n' % k for k in range(n)))
+EOF
+case_ "manifest with 10^6 unknown keys" run "$d"
+d=$(variant some-keys ''); python3 - "$d/manifest.yaml" 1000 <<'EOF'
+import sys; p = sys.argv[1]; n = int(sys.argv[2]); s = open(p).read()
+open(p, 'w').write(s + ''.join('unknown_%d: 1\n' % k for k in range(n)))
+EOF
+n=$("$W" run -m "$d/manifest.yaml" -c single -q -o "$d/out" --formats csv 2>&1 >/dev/null | grep -c warning)
+echo "| manifest with 1000 unknown keys | $? | $n warning lines |"
+
+echo "| **all-or-nothing results** | | |"
+"$W" run -m "$T/manifest.yaml" -c triple -q -o "$S/conc" --formats csv >/dev/null 2>&1 &
+sleep 0.5
+case_ "a second run into a directory another run is writing" trirun -m "$T/manifest.yaml" -c triple -o "$S/conc"
+wait
+case_ "--modules left-C1,left-C1" trirun -m "$T/manifest.yaml" --modules left-C1,left-C1 -o "$S/dup"
+case_ "--formats csv,csv" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/dupf" --formats csv,csv
+"$W" run -m "$T/manifest.yaml" -c triple -q -o "$S/killed" --formats csv,tum >/dev/null 2>&1
+before=$(cd "$S/killed" && md5sum * | md5sum)
+"$W" run -m "$T/manifest.yaml" -c triple -q -o "$S/killed" --formats csv,tum --force --output-interval 0 >/dev/null 2>&1 &
+sleep 0.7; kill -9 $! 2>/dev/null; wait 2>/dev/null
+after=$(cd "$S/killed" && md5sum * | md5sum)
+left=$(ls -a "$S" | grep -c "killed.partial")
+echo "| SIGKILL during run --force | $([ "$before" = "$after" ] && echo 0 || echo 1) | earlier results $([ "$before" = "$after" ] && echo unchanged || echo CHANGED); $left staging dir(s) left |"
+case_ "the next run after the kill (removes the staging dir)" "$W" run -m "$T/manifest.yaml" -c triple -q -o "$S/killed" --formats csv --force
+echo "| staging dirs after it | $(ls -a "$S" | grep -c "killed.partial") | |"
+"$W" simulate --out "$S/sk" --duration 40 --chips 1 --no-ideal -q >/dev/null 2>&1
+before=$(cd "$S/sk" && find . -type f | sort | xargs md5sum | md5sum)
+"$W" simulate --out "$S/sk" --duration 400 --chips 4 --seed 7 --force -q >/dev/null 2>&1 &
+sleep 2; kill -9 $! 2>/dev/null; wait 2>/dev/null
+after=$(cd "$S/sk" && find . -type f | sort | xargs md5sum | md5sum)
+echo "| SIGKILL during simulate --force | $([ "$before" = "$after" ] && echo 0 || echo 1) | earlier dataset $([ "$before" = "$after" ] && echo unchanged || echo CHANGED) |"
+"$W" run -m "$T/manifest.yaml" -c triple -q -o "$S/intr" --formats csv --output-interval 0 >/dev/null 2>&1 &
+sleep 0.7; kill -INT $! 2>/dev/null; wait $!; rc=$?
+echo "| SIGINT during a run | $rc | $(ls -a "$S" | grep -c "intr") entries named intr* left |"
+# Read-only even for root: an immutable directory (chattr), else permissions (non-root).
+mkdir -p "$S/ro"; chmod 555 "$S/ro"; chattr +i "$S/ro" 2>/dev/null
+case_ "experiment -o into a read-only directory (fails before the work)" "$W" experiment "$S/ok" -o "$S/ro/exp" -q
+case_ "run -o under a read-only directory" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/ro/out" --formats csv
+case_ "run -o the dataset directory itself, --force" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/ok" --formats csv --force
+mkdir -p "$S/mine"; echo "my notes" > "$S/mine/notes.txt"
+case_ "run -o a directory with the user's own files, --force" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/mine" --formats csv --force
+case_ "simulate --force over a dataset holding its own --config input" "$W" simulate --out "$S/sk" --config "$S/sk/scenario.yaml" --force -q
+
+echo "| **unclear errors** | | |"
+ln -sfn loop2 "$S/loop1"; ln -sfn loop1 "$S/loop2"
+case_ "a symlink loop as the manifest" "$W" run -m "$S/loop1" -q
+ln -sfn nowhere "$S/dangling"
+case_ "a dangling symlink as the manifest" "$W" run -m "$S/dangling" -q
+rm -f "$S/a-fifo"; mkfifo "$S/a-fifo"
+d=$(variant fifo 's#tri_C1_imu.bin#fifo.bin#'); ln -sf "$S/a-fifo" "$d/left-wheel-imu/fifo.bin"; case_ "a FIFO as the IMU file" run "$d"
+d=$(variant dev-truth 's#^truth: .*#truth: "/dev/null"#'); case_ "/dev/null as the truth file" run "$d"
+python3 -c "print('a: ' + '[' * 500 + ']' * 500)" > "$S/deep.yaml"
+case_ "YAML nested 500 deep (run config, flow style)" "$W" run "$S/deep.yaml" -q
+python3 -c "print('format: wheelins-manifest-1\n' + ''.join('  ' * k + 'k%d:\n' % k for k in range(500)))" > "$S/deep-block.yaml"
+case_ "YAML nested 500 deep (manifest, block style)" "$W" run -m "$S/deep-block.yaml" -q
+case_ "-c triple with --modules left-C1" "$W" run -m "$T/manifest.yaml" -c triple --modules left-C1 -q -o "$S/cf1"
+case_ "-c single with --centralized" "$W" run -m "$T/manifest.yaml" -c single --centralized -q -o "$S/cf2"
+case_ "--modules with --chips" "$W" run -m "$T/manifest.yaml" --modules left-C1 --chips C1 -q -o "$S/cf3"
+case_ "run --duration -5" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/d1" --duration -5
+case_ "run --duration nan" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/d2" --duration nan
+case_ "run --duration 1e400" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/d3" --duration 1e400
+case_ "run --covariance-interval inf" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/d4" --covariance-interval inf
+case_ "experiment --duration -1" "$W" experiment "$S/ok" -o "$S/e1" --duration -1 -q
+case_ "an unknown subcommand with --help" "$W" frobnicate --help
+
+echo "| **the public dataset as it ships** | | |"
+P="$S/public"; rm -rf "$P"; mkdir -p "$P/Wheel-IMU" "$P/Body-IMU" "$P/Ground Truth" "$P/Odometer"
+cp "$T/right-wheel-imu/tri_C1_imu.bin" "$P/Wheel-IMU/C1_imu.bin"
+cp "$T/body-imu/tri_C1_imu.bin" "$P/Body-IMU/C1_imu.bin"
+cp "$T/GINS.bin" "$P/Ground Truth/GINS.bin"; cp "$T/odo.bin" "$P/Odometer/odo.bin"
+case_ "wheelins manifest on Wheel-IMU/ Body-IMU/ 'Ground Truth'/ Odometer/" "$W" manifest "$P"
+case_ "wheelins run on the drafted manifest as it is (single)" "$W" run -m "$P/manifest.yaml" -q -o "$P/out" --formats csv
+case_ "wheelins run -c body-wheel on it" "$W" run -m "$P/manifest.yaml" -c body-wheel -q -o "$P/out-bw" --formats csv
+F="$S/flat"; rm -rf "$F"; mkdir -p "$F"
+cp "$T/right-wheel-imu/tri_C1_imu.bin" "$F/C1_imu.bin"; cp "$T/GINS.bin" "$T/odo.bin" "$F/"
+case_ "wheelins manifest on the flat layout (C1_imu.bin, GINS.bin, odo.bin)" "$W" manifest "$F"
+case_ "wheelins run on it as drafted" "$W" run -m "$F/manifest.yaml" -q -o "$F/out" --formats csv
+chattr -i "$S/ro" 2>/dev/null; chmod 755 "$S/ro"
