@@ -153,7 +153,8 @@ TEST(IoManifest, SaveLoadRoundTripIsExact) {
 TEST(IoManifest, RoundTripOfArbitrarySiValues) {
   // Values that did not come from human units still come back bit-identical.
   std::mt19937_64 rng(42);
-  std::uniform_real_distribution<double> u(-3.0, 3.0), pos(1e-6, 5.0);
+  // Within the keys' physical ranges (docs/manifest.md).
+  std::uniform_real_distribution<double> u(-3.0, 3.0), pos(1e-2, 5.0);
   ScratchDir dir;
   for (int trial = 0; trial < 50; ++trial) {
     Manifest m = sample_manifest();
@@ -319,21 +320,21 @@ TEST(IoManifest, PhysicallyImpossibleValues) {
   const auto mod = [&](const std::string& extra) {
     return load_error(dir, with_modules("modules:\n  - {name: a, kind: wheel, file: a.bin" + extra + "}\n"));
   };
-  EXPECT_HAS(mod(", wheel_radius_m: -0.1"), "modules[0].wheel_radius_m: must be > 0");
-  EXPECT_HAS(mod(", wheel_radius_m: 0"), "modules[0].wheel_radius_m: must be > 0");
+  EXPECT_HAS(mod(", wheel_radius_m: -0.1"), "modules[0].wheel_radius_m: must be in [0.01, 2] m");
+  EXPECT_HAS(mod(", wheel_radius_m: 0"), "modules[0].wheel_radius_m: must be in [0.01, 2] m");
   EXPECT_HAS(mod(""), "modules[0]: missing required key 'wheel_radius_m'");
-  EXPECT_HAS(mod(", wheel_radius_m: 0.1, rate_hz: 0"), "modules[0].rate_hz: must be > 0");
-  EXPECT_HAS(mod(", wheel_radius_m: 0.1, rate_hz: -200"), "modules[0].rate_hz: must be > 0");
+  EXPECT_HAS(mod(", wheel_radius_m: 0.1, rate_hz: 0"), "modules[0].rate_hz: must be in [1, 10000] Hz");
+  EXPECT_HAS(mod(", wheel_radius_m: 0.1, rate_hz: -200"), "modules[0].rate_hz: must be in [1, 10000] Hz");
   EXPECT_HAS(mod(", wheel_radius_m: 0.1, axle_sign: 2"), "modules[0].axle_sign: must be +1");
   EXPECT_HAS(mod(", wheel_radius_m: 0.1, axle_sign: 0"), "modules[0].axle_sign: must be +1");
   EXPECT_HAS(mod(", wheel_radius_m: 0.1, noise: {gyro_arw_deg_sqrt_h: 0}"),
-             "modules[0].noise.gyro_arw_deg_sqrt_h: must be > 0");
+             "modules[0].noise.gyro_arw_deg_sqrt_h: must be in [0.0001, 100]");
   EXPECT_HAS(mod(", wheel_radius_m: 0.1, noise: {acc_sf_tau_h: -1}"),
-             "modules[0].noise.acc_sf_tau_h: must be > 0");
+             "modules[0].noise.acc_sf_tau_h: must be in [0.001, 10000] h");
   EXPECT_HAS(mod(", wheel_radius_m: 0.1, mounting_deg: [0, 95, 0]"), "modules[0].mounting_deg[1]: pitch");
   EXPECT_HAS(load_error(dir, std::string(kMinimal) + "static_period_s: [10, 5]\n"),
              "static_period_s: end 5 is before start 10");
-  EXPECT_HAS(load_error(dir, std::string(kMinimal) + "gravity_m_s2: -9.8\n"), "gravity_m_s2: must be > 0");
+  EXPECT_HAS(load_error(dir, std::string(kMinimal) + "gravity_m_s2: -9.8\n"), "gravity_m_s2: must be in [9.7, 9.9]");
   // A body module needs no radius; +1 written as "+1" is accepted.
   write_text(dir / "ok.yaml", with_modules("modules:\n  - {name: a, kind: body, file: a.bin, axle_sign: +1}\n"));
   EXPECT_EQ(load_manifest(dir / "ok.yaml", kQuiet).modules[0].axle_sign, 1);

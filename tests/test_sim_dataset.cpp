@@ -295,16 +295,22 @@ TEST(SimDataset, BadInputNamesFileAndRecord) {
   fs::remove_all(dir);
 }
 
-// The CLI refuses a non-empty directory without --force.
+// The CLI never writes into a directory with other files (not even with --force: the
+// dataset replaces a directory as a whole), and replaces an earlier dataset only with --force.
 TEST(SimDataset, CliRefusesNonEmptyDirectory) {
   const fs::path dir = temp_dir("cli");
   fs::create_directories(dir);
   std::ofstream(dir / "keep.txt") << "x";
   const std::string cmd = std::string(WHEELINS_BINARY) + " simulate -q --duration 3 --out " + dir.string();
   EXPECT_NE(std::system((cmd + " 2>/dev/null").c_str()), 0);
+  EXPECT_NE(std::system((cmd + " --force 2>/dev/null").c_str()), 0);
   EXPECT_FALSE(fs::exists(dir / "manifest.yaml"));
-  EXPECT_EQ(std::system((cmd + " --force").c_str()), 0);
-  EXPECT_TRUE(fs::exists(dir / "manifest.yaml"));
   EXPECT_TRUE(fs::exists(dir / "keep.txt"));
+  fs::remove(dir / "keep.txt");
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_TRUE(fs::exists(dir / "manifest.yaml"));
+  EXPECT_NE(std::system((cmd + " --seed 2 2>/dev/null").c_str()), 0);
+  EXPECT_EQ(std::system((cmd + " --seed 2 --force").c_str()), 0);
+  EXPECT_TRUE(fs::exists(dir / "manifest.yaml"));
   fs::remove_all(dir);
 }
