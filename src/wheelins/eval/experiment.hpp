@@ -14,6 +14,7 @@
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/fusion/navigator.hpp"
 #include "wheelins/io/diagnostics.hpp"
+#include "wheelins/io/manifest.hpp"
 #include "wheelins/nav/earth.hpp"
 
 namespace wheelins::eval {

@@ -4,7 +4,7 @@
 
 namespace wheelins {
 
-BodyIns::BodyIns(const ModuleSpec& module, const BodyInsOptions& opt,
+BodyIns::BodyIns(const ImuModule& module, const BodyInsOptions& opt,
                  const MechanizationOptions& mech)
     : Subsystem(module, mech), opt_(opt), C_BtoV_(dcm_from_euler(module.mounting_rpy)) {}
 

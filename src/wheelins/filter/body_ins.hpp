@@ -18,7 +18,7 @@ struct BodyInsOptions {
 
 class BodyIns final : public Subsystem {
  public:
-  BodyIns(const ModuleSpec& module, const BodyInsOptions& opt, const MechanizationOptions& mech);
+  BodyIns(const ImuModule& module, const BodyInsOptions& opt, const MechanizationOptions& mech);
 
   /// The Body-IMU b-frame is its sensor frame; C_b^v enters the models instead.
   ImuSample to_body(const ImuSample& sensor) const override { return sensor; }

@@ -3,11 +3,11 @@
 #pragma once
 
 #include "wheelins/filter/error_state.hpp"
-#include "wheelins/io/manifest.hpp"
+#include "wheelins/nav/vehicle.hpp"
 
 namespace wheelins {
 
-/// The noise model of the error states is the manifest's ImuNoise (SI): white noise
+/// The noise model of the error states is the module's ImuNoise (SI): white noise
 /// densities (ARW, VRW) and first-order Gauss-Markov sigmas and correlation times.
 using ProcessNoise = ImuNoise;
 

@@ -6,7 +6,7 @@
 #include "wheelins/filter/alignment.hpp"
 #include "wheelins/filter/position_constraint.hpp"
 #include "wheelins/filter/strapdown_ekf.hpp"
-#include "wheelins/io/manifest.hpp"
+#include "wheelins/nav/vehicle.hpp"
 
 namespace wheelins {
 
@@ -55,14 +55,14 @@ class MotionAccumulator {
 
 class Subsystem {
  public:
-  Subsystem(const ModuleSpec& module, const MechanizationOptions& mech)
+  Subsystem(const ImuModule& module, const MechanizationOptions& mech)
       : module_(module), mech_(mech) {}
   virtual ~Subsystem() = default;
   Subsystem(const Subsystem&) = delete;
   Subsystem& operator=(const Subsystem&) = delete;
 
   bool is_wheel() const { return module_.kind == ModuleKind::kWheel; }
-  const ModuleSpec& module() const { return module_; }
+  const ImuModule& module() const { return module_; }
   StrapdownEkf& ekf() { return ekf_; }
   const StrapdownEkf& ekf() const { return ekf_; }
   double time() const { return ekf_.state().t; }
@@ -88,7 +88,7 @@ class Subsystem {
   Vec3 reference_point_inW() const { return reference_point_model(reference_point_input()).r_o; }
 
  protected:
-  ModuleSpec module_;
+  ImuModule module_;
   MechanizationOptions mech_;
   StrapdownEkf ekf_;
 };

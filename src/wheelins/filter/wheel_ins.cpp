@@ -5,7 +5,7 @@
 
 namespace wheelins {
 
-WheelIns::WheelIns(const ModuleSpec& module, const WheelInsOptions& opt,
+WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
                    const MechanizationOptions& mech)
     : Subsystem(module, mech),
       opt_(opt),

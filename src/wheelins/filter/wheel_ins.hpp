@@ -23,7 +23,7 @@ class WheelIns final : public Subsystem {
  public:
   static constexpr int kMaxWindow = 256;
 
-  WheelIns(const ModuleSpec& module, const WheelInsOptions& opt, const MechanizationOptions& mech);
+  WheelIns(const ImuModule& module, const WheelInsOptions& opt, const MechanizationOptions& mech);
 
   /// Rotates a raw sample from the sensor axes into the ideal wheel b-frame (mounting angles).
   ImuSample to_body(const ImuSample& sensor) const override;

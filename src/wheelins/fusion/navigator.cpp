@@ -46,22 +46,24 @@ std::string NavigatorOptions::describe() const {
   return o.str();
 }
 
-Navigator::Navigator(const Manifest& manifest, const std::vector<std::string>& modules,
+Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& modules,
                      const NavigatorOptions& options, Sink sink)
-    : manifest_(manifest), opt_(options), sink_(std::move(sink)), frame_(manifest.origin) {
+    : setup_(setup), opt_(options), sink_(std::move(sink)), frame_(setup.origin) {
   if (modules.empty()) throw InputError("no module selected: name at least one Wheel-IMU");
   MechanizationOptions mech;
   mech.method = opt_.mechanization;
-  mech.gravity = manifest_.gravity_or_default();
-  if (opt_.earth_rotation) mech.omega_ie_inW = earth::earth_rate_ned(manifest_.origin.lat);
+  mech.gravity = setup_.gravity;
+  if (opt_.earth_rotation) mech.omega_ie_inW = earth::earth_rate_ned(setup_.origin.lat);
   for (const auto& name : modules) {
-    const ModuleSpec* m = manifest_.find(name);
+    const ImuModule* m = setup_.find(name);
     if (!m) {
       std::string known;
-      for (const auto& mm : manifest_.modules) known += (known.empty() ? "" : ", ") + mm.name;
-      throw InputError("'" + manifest_.path.string() + "': no module named '" + name +
+      for (const auto& mm : setup_.modules) known += (known.empty() ? "" : ", ") + mm.name;
+      throw InputError("'" + setup_.source + "': no module named '" + name +
                        "' (modules: " + known + ")");
     }
+    const std::size_t at = static_cast<std::size_t>(m - setup_.modules.data());
+    sources_.push_back(at < setup_.data_sources.size() ? setup_.data_sources[at] : m->name);
     if (m->kind == ModuleKind::kWheel) {
       auto w = std::make_unique<WheelIns>(*m, opt_.wheel, mech);
       wheels_.push_back(w.get());
@@ -121,12 +123,12 @@ void Navigator::process(int index, const ImuSample& raw) {
   Subsystem& s = *subs_[index];
   ImuSample b = s.to_body(raw);
   if (!navigating_) {
-    if (raw.t <= manifest_.static_start) return;
-    if (raw.t <= manifest_.static_end + 1e-9) {
+    if (raw.t <= setup_.static_start) return;
+    if (raw.t <= setup_.static_end + 1e-9) {
       static_[index].add(b);
       return;
     }
-    start_navigation(manifest_.static_end);
+    start_navigation(setup_.static_end);
   }
   if (opt_.faults.enabled) {
     Runtime& rt = rt_[index];
@@ -194,15 +196,14 @@ void Navigator::start_navigation(double t0) {
   for (std::size_t i = 0; i < subs_.size(); ++i) {
     if (static_[i].count() < 10) {
       char period[96];
-      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", manifest_.static_start,
-                    manifest_.static_end);
-      throw InputError("'" + manifest_.resolve(subs_[i]->module().file).string() + "' (module '" +
-                       subs_[i]->module().name + "'): only " +
-                       std::to_string(static_[i].count()) + " samples in the static period " +
-                       period + " of '" + manifest_.path.string() +
+      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", setup_.static_start,
+                    setup_.static_end);
+      throw InputError("'" + sources_[i] + "' (module '" + subs_[i]->module().name +
+                       "'): only " + std::to_string(static_[i].count()) +
+                       " samples in the static period " + period + " of '" + setup_.source +
                        "': the alignment needs the static period covered by every module's data");
     }
-    subs_[i]->start(static_[i], manifest_.initial_heading, t0);
+    subs_[i]->start(static_[i], setup_.initial_heading, t0);
     rt_[i].last_t = t0;
   }
   if (opt_.fusion.centralized && subs_.size() > 1) {

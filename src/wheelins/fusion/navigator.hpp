@@ -21,7 +21,8 @@
 #include "wheelins/filter/wheel_ins.hpp"
 #include "wheelins/fusion/centralized.hpp"
 #include "wheelins/fusion/fault_monitor.hpp"
-#include "wheelins/io/trajectory.hpp"
+#include "wheelins/nav/trajectory_record.hpp"
+#include "wheelins/nav/vehicle.hpp"
 
 namespace wheelins {
 
@@ -102,9 +103,10 @@ class Navigator {
   /// subsystems' own solutions (only when N > 1).
   using Sink = std::function<void(int stream, const TrajectoryRecord&)>;
 
-  /// `modules`: names from the manifest; the first one drives the output epochs.
-  /// Throws InputError if a name is unknown or the set has no Wheel-IMU.
-  Navigator(const Manifest& manifest, const std::vector<std::string>& modules,
+  /// `modules`: names of modules of `setup`; the first one drives the output epochs.
+  /// Throws InputError if a name is unknown or the set has no Wheel-IMU. (A Manifest
+  /// converts to its VehicleSetup: Navigator(manifest, modules, options, sink).)
+  Navigator(const VehicleSetup& setup, const std::vector<std::string>& modules,
             const NavigatorOptions& options, Sink sink);
   ~Navigator();
 
@@ -219,7 +221,8 @@ class Navigator {
   VehicleFix vehicle_fix(int i, double t) const;
   void fault_housekeeping(double t);
 
-  Manifest manifest_;
+  VehicleSetup setup_;
+  std::vector<std::string> sources_;  ///< per subsystem: where its samples come from
   NavigatorOptions opt_;
   Sink sink_;
   earth::LocalFrame frame_;

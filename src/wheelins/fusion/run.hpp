@@ -9,6 +9,7 @@
 
 #include "wheelins/fusion/navigator.hpp"
 #include "wheelins/io/diagnostics.hpp"
+#include "wheelins/io/manifest.hpp"
 #include "wheelins/io/trajectory.hpp"
 
 namespace wheelins {

@@ -443,6 +443,23 @@ double Manifest::gravity_or_default() const {
   return gravity ? *gravity : earth::normal_gravity(origin.lat, origin.h);
 }
 
+VehicleSetup vehicle_setup(const Manifest& m) {
+  VehicleSetup s;
+  s.source = m.path.string();
+  s.origin = m.origin;
+  s.static_start = m.static_start;
+  s.static_end = m.static_end;
+  s.initial_heading = m.initial_heading;
+  s.gravity = m.gravity_or_default();
+  for (const ModuleSpec& spec : m.modules) {
+    s.modules.push_back(spec);  // the ImuModule part
+    s.data_sources.push_back(m.resolve(spec.file).string());
+  }
+  return s;
+}
+
+Manifest::operator VehicleSetup() const { return vehicle_setup(*this); }
+
 Manifest load_manifest(const fs::path& file) { return load_manifest(file, stderr_sink()); }
 
 Manifest load_manifest(const fs::path& file, const WarningSink& warn) {

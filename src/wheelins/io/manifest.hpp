@@ -14,53 +14,22 @@
 
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/nav/earth.hpp"
+#include "wheelins/nav/vehicle.hpp"
 
 namespace wheelins {
 
-enum class ModuleKind { kWheel, kBody };
 enum class SampleFormat { kRate, kIncrement };  ///< rad/s & m/s^2, or rad & m/s per sample
 enum class FileLayout { kBinary, kText };       ///< float64 LE rows, or whitespace/CSV text
 
-/// Noise figures a filter assumes for one IMU (SI: rad, s, m).
-struct ImuNoise {
-  double gyro_arw = 0.24 * kDeg / 60.0;   ///< angle random walk [rad/sqrt(s)]
-  double acc_vrw = 0.3 / 60.0;            ///< velocity random walk [m/s/sqrt(s)]
-  double gyro_bias_std = 50.0 * kDeg / 3600.0;  ///< residual gyro bias std [rad/s]
-  double acc_bias_std = 0.01;             ///< residual accelerometer bias std [m/s^2]
-  double gyro_sf_std = 3000e-6;           ///< residual gyro scale-factor std [-]
-  double acc_sf_std = 3000e-6;            ///< residual accelerometer scale-factor std [-]
-  double gyro_bias_tau = 3600.0;          ///< Gauss-Markov correlation times [s]
-  double acc_bias_tau = 3600.0;
-  double gyro_sf_tau = 3600.0;
-  double acc_sf_tau = 3600.0;
-};
-
-/// One IMU module (one chip's data file).
-struct ModuleSpec {
-  std::string name;            ///< unique, e.g. "left-C1"
-  ModuleKind kind = ModuleKind::kWheel;
+/// One IMU module (one chip's data file): the module as the estimator knows it (name, kind,
+/// rate, geometry, noise: ImuModule, nav/vehicle.hpp) and where and how its data are stored.
+struct ModuleSpec : ImuModule {
   std::string group;           ///< physical module, e.g. "left-wheel" (its chips share it)
   std::string chip;            ///< e.g. "C1"
   std::filesystem::path file;  ///< absolute, or relative to the manifest's directory
   SampleFormat format = SampleFormat::kRate;
   FileLayout layout = FileLayout::kBinary;
-  double rate_hz = 200.0;       ///< nominal sample rate
   double time_offset = 0.0;     ///< added to the file's timestamps [s]
-  /// Wheel-IMU: the wheel centre in the v-frame. Body-IMU: the IMU centre in the v-frame. [m]
-  Vec3 p_inV = Vec3::Zero();
-  /// Wheel-IMU: lever arm from the IMU centre to the wheel centre in the b-frame [m].
-  Vec3 lever_arm_inB = Vec3::Zero();
-  /// Body-IMU: C_b^v as ZYX Euler [roll, pitch, yaw]. Wheel-IMU: the small rotation of the
-  /// sensor axes from the ideal wheel b-frame (the paper's mounting angles). [rad]
-  Vec3 mounting_rpy = Vec3::Zero();
-  int axle_sign = 1;            ///< Wheel-IMU: +1 if b x-axis points right, -1 if left
-  double wheel_radius = 0.0;    ///< Wheel-IMU nominal wheel radius [m]
-  /// Gyro full scale [rad/s] (readings at it are saturated); 0 = not stated.
-  double gyro_range = 0.0;
-  /// Accelerometer full scale [m/s^2]; 0 = not stated. A reading beyond either range (+5 %)
-  /// cannot come from the sensor: the run leaves it out as a fault.
-  double accel_range = 0.0;
-  ImuNoise noise;
 };
 
 struct Manifest {
@@ -81,7 +50,15 @@ struct Manifest {
   std::filesystem::path resolve(const std::filesystem::path& p) const;
   const ModuleSpec* find(const std::string& module_name) const;
   double gravity_or_default() const;
+  /// What the navigator is told (vehicle_setup()): a Manifest converts implicitly, so a
+  /// Navigator is made straight from one.
+  operator VehicleSetup() const;
 };
+
+/// The manifest without its files: every module's geometry and noise, the origin, the static
+/// period, the initial heading and gravity (the default if not stated); the module files,
+/// resolved, as the data sources named in messages.
+VehicleSetup vehicle_setup(const Manifest& m);
 
 /// Reads and validates a manifest; throws InputError naming the file and the key.
 /// Warnings (unknown keys, with the closest known key) are printed on stderr.
