@@ -5,9 +5,9 @@
 #include <sstream>
 
 #include "cli.hpp"
-#include "wheelins/eval/experiment.hpp"
-#include "wheelins/eval/plots.hpp"
-#include "wheelins/fusion/run_config.hpp"
+#include "wheelins/run/experiment.hpp"
+#include "wheelins/run/plots.hpp"
+#include "wheelins/run/run_config.hpp"
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/output_dir.hpp"
 #include "wheelins/io/truth.hpp"

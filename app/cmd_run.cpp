@@ -9,9 +9,9 @@
 
 #include "cli.hpp"
 #include "wheelins/eval/metrics.hpp"
-#include "wheelins/fusion/presets.hpp"
-#include "wheelins/fusion/run.hpp"
-#include "wheelins/fusion/run_config.hpp"
+#include "wheelins/run/presets.hpp"
+#include "wheelins/run/run.hpp"
+#include "wheelins/run/run_config.hpp"
 #include "wheelins/io/truth.hpp"
 
 namespace {

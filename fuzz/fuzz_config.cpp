@@ -6,8 +6,8 @@
 
 #include "fuzz_common.hpp"
 #include "wheelins/eval/metrics.hpp"
-#include "wheelins/fusion/run.hpp"
-#include "wheelins/fusion/run_config.hpp"
+#include "wheelins/run/run.hpp"
+#include "wheelins/run/run_config.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/sim/config.hpp"
 

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "io_test_util.hpp"
-#include "wheelins/eval/experiment.hpp"
-#include "wheelins/eval/plots.hpp"
+#include "wheelins/run/experiment.hpp"
+#include "wheelins/run/plots.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/math/rotation.hpp"
 

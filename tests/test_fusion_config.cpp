@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "io_test_util.hpp"
-#include "wheelins/fusion/presets.hpp"
-#include "wheelins/fusion/run_config.hpp"
+#include "wheelins/run/presets.hpp"
+#include "wheelins/run/run_config.hpp"
 
 using namespace wheelins;
 using iotest::error_of;

@@ -15,7 +15,7 @@
 
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/fusion/navigator.hpp"
-#include "wheelins/fusion/presets.hpp"
+#include "wheelins/run/presets.hpp"
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/sim/faults.hpp"

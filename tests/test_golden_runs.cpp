@@ -18,8 +18,8 @@
 #include <random>
 #include <sstream>
 
-#include "wheelins/fusion/presets.hpp"
-#include "wheelins/fusion/run.hpp"
+#include "wheelins/run/presets.hpp"
+#include "wheelins/run/run.hpp"
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/sim/simulator.hpp"

@@ -14,9 +14,9 @@
 
 #include "io_test_util.hpp"
 #include "wheelins/eval/metrics.hpp"
-#include "wheelins/fusion/presets.hpp"
-#include "wheelins/fusion/run.hpp"
-#include "wheelins/fusion/run_config.hpp"
+#include "wheelins/run/presets.hpp"
+#include "wheelins/run/run.hpp"
+#include "wheelins/run/run_config.hpp"
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/io/output_dir.hpp"

@@ -10,8 +10,8 @@
 #include <random>
 
 #include "wheelins/eval/metrics.hpp"
-#include "wheelins/fusion/presets.hpp"
-#include "wheelins/fusion/run.hpp"
+#include "wheelins/run/presets.hpp"
+#include "wheelins/run/run.hpp"
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/sim/simulator.hpp"

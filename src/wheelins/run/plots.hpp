@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "wheelins/eval/experiment.hpp"
+#include "wheelins/run/experiment.hpp"
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/nav/earth.hpp"

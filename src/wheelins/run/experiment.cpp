@@ -1,4 +1,4 @@
-#include "wheelins/eval/experiment.hpp"
+#include "wheelins/run/experiment.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -10,7 +10,7 @@
 #include <sstream>
 #include <thread>
 
-#include "wheelins/fusion/run.hpp"
+#include "wheelins/run/run.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/util/progress.hpp"
 

@@ -5,6 +5,9 @@
 // right Cj); 16 Body/Wheel-INS (left Ci, body Cj); 16 Triple INS (left Ci, right Cj,
 // body C(((i+j) mod 4) + 1)); and the first 8 Triple INS combinations again with the
 // centralized filter (Table 7/8).
+//
+// It drives its runs through the run driver (run/run.hpp) and evaluates them with eval/,
+// so it sits in the top layer; its names stay in namespace wheelins::eval.
 #pragma once
 
 #include <filesystem>

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "wheelins/fusion/run.hpp"
+#include "wheelins/run/run.hpp"
 
 namespace wheelins {
 

@@ -1,8 +1,8 @@
-#include "wheelins/fusion/run_config.hpp"
+#include "wheelins/run/run_config.hpp"
 
 #include <cmath>
 
-#include "wheelins/fusion/presets.hpp"
+#include "wheelins/run/presets.hpp"
 #include "wheelins/io/yaml_reader.hpp"
 
 namespace wheelins {

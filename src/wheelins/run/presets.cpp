@@ -1,4 +1,4 @@
-#include "wheelins/fusion/presets.hpp"
+#include "wheelins/run/presets.hpp"
 
 #include <algorithm>
 

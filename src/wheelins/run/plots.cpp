@@ -1,4 +1,4 @@
-#include "wheelins/eval/plots.hpp"
+#include "wheelins/run/plots.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>

@@ -1,4 +1,4 @@
-#include "wheelins/fusion/run.hpp"
+#include "wheelins/run/run.hpp"
 
 #include <algorithm>
 #include <chrono>
