@@ -247,11 +247,11 @@ TEST_F(NavEndToEnd, CentralizedMeasurementJacobiansMatchFiniteDifference) {
     int checked = 0, cross = 0;
     for (int kind = 0; kind < 2; ++kind)
       for (int i = 0; i < N; ++i) {
-        auto measure = [&](JointMeasurement& jm) {
+        auto measure = [&](Measurement& jm) {
           if (kind == 0) navigator.velocity_measurement(i, jm);
           else navigator.position_measurement(i, jm);
         };
-        JointMeasurement m0, mp, mn;
+        Measurement m0, mp, mn;
         measure(m0);
         for (int j = 0; j < N; ++j)
           for (int k = 0; k < kStateDim; ++k) {

@@ -64,7 +64,7 @@ void StrapdownEkf::clear_pending() {
 }
 
 void StrapdownEkf::flush_covariance() {
-  if (!own_covariance_ || pending_dt_ <= 0.0) return;
+  if (pending_dt_ <= 0.0) return;
   propagate_covariance(P_, pending_dynamics(), noise_, pending_dt_);
   clear_pending();
 }

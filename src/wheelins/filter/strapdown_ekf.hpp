@@ -25,16 +25,15 @@ class StrapdownEkf {
   void initialize(const NavState& state, const ImuErrors& errors, const ProcessNoise& noise,
                   const InitialUncertainty& init, const MechanizationOptions& mech);
 
-  /// One IMU epoch: compensate, mechanize, and accumulate F; the covariance is
-  /// propagated once `covariance_interval` has passed (see set_covariance_interval).
-  /// `raw` is in the IMU b-frame (mounting already applied), as increments.
+  /// One IMU epoch of a stand-alone filter: compensate, mechanize, and accumulate F; the
+  /// covariance is propagated once `covariance_interval` has passed (see
+  /// set_covariance_interval). `raw` is in the IMU b-frame (mounting already applied), as
+  /// increments. (In the navigator the fusion filter owns the time update: the subsystems
+  /// propagate the nominal state only, fusion/filter_backend.hpp.)
   void propagate(const ImuSample& raw) {
     propagate_nominal(raw);
-    if (own_covariance_ && covariance_due()) flush_covariance();
+    if (covariance_due()) flush_covariance();
   }
-  /// A centralized filter keeps the covariance: propagate() then leaves this one's P alone
-  /// and the owner takes the accumulated dynamics (pending_dynamics, clear_pending).
-  void set_external_covariance(bool external) { own_covariance_ = !external; }
   /// The nominal part only (compensation, mechanization, F of this epoch accumulated).
   void propagate_nominal(const ImuSample& raw);
 
@@ -50,7 +49,8 @@ class StrapdownEkf {
   bool covariance_due() const { return pending_dt_ + 1e-9 >= covariance_interval_; }
   /// Propagates the own P over the accumulated epochs (no-op if none).
   void flush_covariance();
-  /// The accumulated F blocks averaged over pending_dt() (for an external covariance).
+  /// The accumulated F blocks averaged over pending_dt() (for a joint covariance that
+  /// propagates this IMU's block itself, fusion/centralized.hpp).
   ErrorDynamics pending_dynamics() const;
   double pending_dt() const { return pending_dt_; }
   void clear_pending();
@@ -104,7 +104,6 @@ class StrapdownEkf {
   ImuSample last_raw_;
   bool have_last_ = false;
   bool initialized_ = false;
-  bool own_covariance_ = true;
 };
 
 }  // namespace wheelins

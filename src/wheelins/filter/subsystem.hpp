@@ -75,8 +75,9 @@ class Subsystem {
   /// realignment, b-frame now), heading and o from `fix`; the sensor-error estimates are
   /// kept, their uncertainty is reset to the datasheet's.
   virtual void restart(const Vec3& mean_f_inB, const VehicleFix& fix) = 0;
-  /// One IMU epoch of b-frame data.
-  virtual void propagate(const ImuSample& body_sample) { ekf_.propagate(body_sample); }
+  /// One IMU epoch of b-frame data: the nominal state. The covariance time update is the
+  /// fusion filter's (the subsystem's own P, or its block of a joint covariance).
+  virtual void propagate(const ImuSample& body_sample) { ekf_.propagate_nominal(body_sample); }
   virtual double vehicle_heading() const = 0;
   /// d(heading)/d(phi), for the heading's 1-sigma.
   virtual Eigen::RowVector3d heading_sensitivity() const = 0;

@@ -74,7 +74,7 @@ double WheelIns::ins_speed() const {
 }
 
 void WheelIns::propagate(const ImuSample& body_sample) {
-  ekf_.propagate(body_sample);
+  ekf_.propagate_nominal(body_sample);
   // The window keeps the uncompensated rate; mean_omega_x() compensates it with the current
   // estimates, so the speed stays consistent with the error state after every feedback
   // (a centralized filter corrects this IMU's b_g,x / s_g,x between two updates of one epoch).

@@ -94,4 +94,43 @@ std::unique_ptr<JointCovariance> make_joint_covariance(int n) {
   }
 }
 
+CentralizedFilter::CentralizedFilter(Subsystems& subs)
+    : subs_(subs), joint_(make_joint_covariance(subs.size())) {}
+
+void CentralizedFilter::start() {
+  for (int i = 0; i < subs_.size(); ++i) joint_->set_block(i, subs_[i].ekf().covariance());
+}
+
+void CentralizedFilter::propagate_joint(int i) {
+  StrapdownEkf& ekf = subs_[i].ekf();
+  if (ekf.pending_dt() <= 0.0) return;
+  joint_->propagate(i, ekf.pending_dynamics(), ekf.noise(), ekf.pending_dt());
+  ekf.clear_pending();
+}
+
+void CentralizedFilter::propagated(int i) {
+  if (subs_[i].ekf().covariance_due()) propagate_joint(i);
+}
+
+void CentralizedFilter::flush() {
+  for (int i = 0; i < subs_.size(); ++i) propagate_joint(i);
+}
+
+const Mat21& CentralizedFilter::covariance(int i, Mat21& scratch) const {
+  scratch = joint_->block(i);
+  return scratch;
+}
+
+UpdateReport CentralizedFilter::fuse(const Measurement& m) {
+  std::array<const H3*, kMaxCentralized> blocks{};
+  for (int j = 0; j < m.n; ++j) blocks[j] = &m.H[j];
+  std::array<Vec21, kMaxCentralized> dx;
+  const UpdateReport rep = joint_->update(blocks, m.dz, m.R, m.gate, dx);
+  if (rep.accepted)
+    for (int j = 0; j < subs_.size(); ++j) subs_[j].ekf().feedback(dx[j]);
+  return rep;
+}
+
+void CentralizedFilter::restarted(int i) { joint_->reset(i, subs_[i].ekf().covariance()); }
+
 }  // namespace wheelins

@@ -1,8 +1,9 @@
-// The centralized filter's covariance (paper Section VI-B-2): one EKF whose
-// error state stacks the 21 states of all N IMUs, so the cross-correlations the
-// distributed filter ignores are carried by the joint covariance. The nominal
-// states stay in the subsystems; this class holds the (21N x 21N) covariance,
-// fixed-size (N = 2..5), and applies the same process and measurement models.
+// The centralized filter (paper Section VI-B-2): one EKF whose error state stacks
+// the 21 states of all N IMUs, so the cross-correlations the distributed filter
+// ignores are carried by the joint covariance. The nominal states stay in the
+// subsystems; JointCovariance holds the (21N x 21N) covariance, fixed-size
+// (N = 2..5), and applies the same process and measurement models; CentralizedFilter
+// is the fusion's back-end over it (filter_backend.hpp).
 #pragma once
 
 #include <array>
@@ -10,11 +11,11 @@
 
 #include "wheelins/filter/ekf_update.hpp"
 #include "wheelins/filter/error_model.hpp"
+#include "wheelins/fusion/filter_backend.hpp"
 
 namespace wheelins {
 
 constexpr int kMaxCentralized = 5;
-using H3 = Eigen::Matrix<double, 3, kStateDim>;
 
 class JointCovariance {
  public:
@@ -36,5 +37,26 @@ class JointCovariance {
 
 /// A joint covariance for n subsystems (2 <= n <= kMaxCentralized); InputError otherwise.
 std::unique_ptr<JointCovariance> make_joint_covariance(int n);
+
+/// The back-end: the subsystems' time updates go into the joint covariance, and every
+/// measurement is fused with all its blocks.
+class CentralizedFilter final : public FilterBackend {
+ public:
+  /// InputError unless 2 <= subs.size() <= kMaxCentralized.
+  explicit CentralizedFilter(Subsystems& subs);
+  bool joint() const override { return true; }
+  void start() override;
+  void propagated(int i) override;
+  void flush() override;
+  const Mat21& covariance(int i, Mat21& scratch) const override;
+  UpdateReport fuse(const Measurement& m) override;
+  void restarted(int i) override;
+
+ private:
+  /// Moves subsystem i's accumulated dynamics into the joint covariance.
+  void propagate_joint(int i);
+  Subsystems& subs_;
+  std::unique_ptr<JointCovariance> joint_;
+};
 
 }  // namespace wheelins

@@ -11,94 +11,21 @@
 
 namespace wheelins {
 
-std::string NavigatorOptions::describe() const {
-  std::ostringstream o;
-  auto onoff = [](bool b) { return b ? "on" : "off"; };
-  o << "velocity update interval:   " << wheel.velocity_update_interval << " s\n"
-    << "wheel speed window:         " << wheel.speed_window << " s\n"
-    << "wheel speed sharing:        "
-    << (fusion.speed == SpeedSharing::kMean ? "mean of Wheel-IMUs (paper)" : "own wheel") << "\n"
-    << "Wheel-INS velocity sigma:   " << wheel.velocity_std.transpose() << " m/s\n"
-    << "Body-INS velocity sigma:    " << body.velocity_std.transpose() << " m/s\n"
-    << "position constraint:        " << onoff(fusion.position_constraint) << ", every "
-    << fusion.position_update_interval << " s, sigma " << fusion.position_std << " m\n"
-    << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
-    << "filter structure:           "
-    << (fusion.centralized ? "centralized (one joint covariance)" : "distributed (paper)") << "\n"
-    << "innovation gates (vel/pos): " << wheel.gate << " / " << fusion.position_gate
-    << " (0 = off)\n"
-    << "initial sigma:              position " << wheel.init.position << " m, velocity "
-    << wheel.init.velocity << " m/s, roll/pitch " << wheel.init.roll_pitch / kDeg
-    << " deg, heading " << wheel.init.heading / kDeg << " deg\n"
-    << "mechanization:              "
-    << (mechanization == MechanizationOptions::Method::kRotationExact ? "rotation-exact"
-                                                                       : "classic two-sample")
-    << "\n"
-    << "earth rotation:             " << (earth_rotation ? "compensated" : "ignored") << "\n"
-    << "covariance time update:     "
-    << (covariance_interval > 0 ? "every " + std::to_string(covariance_interval) + " s"
-                                : std::string("every epoch"))
-    << "\n"
-    << faults.describe()
-    << "output interval:            "
-    << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
-    << "\n";
-  return o.str();
-}
-
 Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& modules,
                      const NavigatorOptions& options, Sink sink)
-    : setup_(setup), opt_(options), sink_(std::move(sink)), frame_(setup.origin) {
-  if (modules.empty()) throw InputError("no module selected: name at least one Wheel-IMU");
-  MechanizationOptions mech;
-  mech.method = opt_.mechanization;
-  mech.gravity = setup_.gravity;
-  if (opt_.earth_rotation) mech.omega_ie_inW = earth::earth_rate_ned(setup_.origin.lat);
-  for (const auto& name : modules) {
-    const ImuModule* m = setup_.find(name);
-    if (!m) {
-      std::string known;
-      for (const auto& mm : setup_.modules) known += (known.empty() ? "" : ", ") + mm.name;
-      throw InputError("'" + setup_.source + "': no module named '" + name +
-                       "' (modules: " + known + ")");
-    }
-    const std::size_t at = static_cast<std::size_t>(m - setup_.modules.data());
-    sources_.push_back(at < setup_.data_sources.size() ? setup_.data_sources[at] : m->name);
-    if (m->kind == ModuleKind::kWheel) {
-      auto w = std::make_unique<WheelIns>(*m, opt_.wheel, mech);
-      wheels_.push_back(w.get());
-      subs_.push_back(std::move(w));
-    } else {
-      if (body_)
-        throw InputError("module '" + name + "': only one Body-IMU can share its attitude; '" +
-                         body_->module().name + "' is already selected");
-      auto b = std::make_unique<BodyIns>(*m, opt_.body, mech);
-      body_ = b.get();
-      body_index_ = static_cast<int>(subs_.size());
-      subs_.push_back(std::move(b));
-    }
-    subs_.back()->ekf().set_covariance_interval(opt_.covariance_interval);
-  }
-  if (wheels_.empty())
-    throw InputError("no Wheel-IMU among the selected modules: at least one IMU must be on a "
-                     "wheel to measure the wheel speed");
-  weights_ = opt_.fusion.weights;
-  if (weights_.empty()) weights_.assign(subs_.size(), 1.0);
-  if (weights_.size() != subs_.size())
-    throw InputError("fusion weights: " + std::to_string(weights_.size()) + " given for " +
-                     std::to_string(subs_.size()) + " modules");
-  const double wsum = std::accumulate(weights_.begin(), weights_.end(), 0.0);
-  for (double w : weights_)
-    if (!(w > 0.0) || !std::isfinite(wsum))  // a zero weight leaves the mean undefined when the others drop out
-      throw InputError("fusion weights must be > 0 and finite (leave a module out instead of weighting it 0)");
-  for (double& w : weights_) w /= wsum;
-  if (subs_.size() > static_cast<std::size_t>(kMaxModules))
-    throw InputError(std::to_string(subs_.size()) + " modules selected; at most " +
-                     std::to_string(kMaxModules) + " can be fused");
+    : opt_(options),
+      sink_(std::move(sink)),
+      frame_(setup.origin),
+      source_(setup.source),
+      static_start_(setup.static_start),
+      static_end_(setup.static_end),
+      initial_heading_(setup.initial_heading),
+      subs_(setup, modules, options) {
+  opt_.validate();
+  filter_ = make_filter_backend(subs_, opt_.fusion.centralized);
   static_.resize(subs_.size());
-  rp_models_.resize(subs_.size());
   std::vector<std::string> names;
-  for (const auto& sub : subs_) names.push_back(sub->module().name);
+  for (int i = 0; i < subs_.size(); ++i) names.push_back(subs_[i].module().name);
   faults_ = FaultMonitor(std::move(names), opt_.faults);
   rt_.resize(subs_.size());
 }
@@ -108,7 +35,7 @@ Navigator::~Navigator() = default;
 double Navigator::min_time() const {
   double t = std::numeric_limits<double>::infinity();
   for (int i = 0; i < subsystem_count(); ++i)
-    if (in_use(i)) t = std::min(t, subs_[i]->time());
+    if (in_use(i)) t = std::min(t, subs_[i].time());
   return t;
 }
 
@@ -120,15 +47,15 @@ int Navigator::output_driver() const {
 
 void Navigator::process(int index, const ImuSample& raw) {
   ++stats_.samples;
-  Subsystem& s = *subs_[index];
+  Subsystem& s = subs_[index];
   ImuSample b = s.to_body(raw);
   if (!navigating_) {
-    if (raw.t <= setup_.static_start) return;
-    if (raw.t <= setup_.static_end + 1e-9) {
+    if (raw.t <= static_start_) return;
+    if (raw.t <= static_end_ + 1e-9) {
       static_[index].add(b);
       return;
     }
-    start_navigation(setup_.static_end);
+    start_navigation(static_end_);
   }
   if (opt_.faults.enabled) {
     Runtime& rt = rt_[index];
@@ -153,7 +80,7 @@ void Navigator::process(int index, const ImuSample& raw) {
     if (s.is_wheel() && s.module().gyro_range > 0.0) handle_saturation(index, raw, b);
   }
   s.propagate(b);
-  if (joint_ && s.ekf().covariance_due()) propagate_joint(index);
+  filter_->propagated(index);
 
   // Updates when every subsystem in use has reached the scheduled time.
   const double t_all = min_time();
@@ -161,7 +88,7 @@ void Navigator::process(int index, const ImuSample& raw) {
   if (t_all + 1e-9 >= next_velocity_t_) {
     // Every P brought to this epoch before a measurement uses it; outside the timed step,
     // since the time update is not the velocity step's cost (Table 8).
-    flush_covariances();
+    filter_->flush();
     const auto t0 = Clock::now();
     velocity_updates();
     check_covariances();
@@ -170,7 +97,7 @@ void Navigator::process(int index, const ImuSample& raw) {
     while (next_velocity_t_ <= t_all + 1e-9) next_velocity_t_ += opt_.wheel.velocity_update_interval;
   }
   if (subs_.size() > 1 && opt_.fusion.position_constraint && t_all + 1e-9 >= next_position_t_) {
-    flush_covariances();
+    filter_->flush();
     const auto t0 = Clock::now();
     position_update();
     stats_.position_step_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -193,26 +120,19 @@ void Navigator::process(int index, const ImuSample& raw) {
 }
 
 void Navigator::start_navigation(double t0) {
-  for (std::size_t i = 0; i < subs_.size(); ++i) {
+  for (int i = 0; i < subs_.size(); ++i) {
     if (static_[i].count() < 10) {
       char period[96];
-      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", setup_.static_start,
-                    setup_.static_end);
-      throw InputError("'" + sources_[i] + "' (module '" + subs_[i]->module().name +
+      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", static_start_, static_end_);
+      throw InputError("'" + subs_.source(i) + "' (module '" + subs_[i].module().name +
                        "'): only " + std::to_string(static_[i].count()) +
-                       " samples in the static period " + period + " of '" + setup_.source +
+                       " samples in the static period " + period + " of '" + source_ +
                        "': the alignment needs the static period covered by every module's data");
     }
-    subs_[i]->start(static_[i], setup_.initial_heading, t0);
+    subs_[i].start(static_[i], initial_heading_, t0);
     rt_[i].last_t = t0;
   }
-  if (opt_.fusion.centralized && subs_.size() > 1) {
-    joint_ = make_joint_covariance(subsystem_count());
-    for (int i = 0; i < subsystem_count(); ++i) {
-      joint_->set_block(i, subs_[i]->ekf().covariance());
-      subs_[i]->ekf().set_external_covariance(true);
-    }
-  }
+  filter_->start();
   navigating_ = true;
   stats_.t_start = t0;
   next_output_t_ = t0;
@@ -223,120 +143,37 @@ void Navigator::start_navigation(double t0) {
 bool Navigator::level_shared() const {
   // The Body-INS level is shared only while the Body-INS counts (a module on probation or
   // out does not pass its attitude on; the wheels keep the last level they were given).
-  return body_ && opt_.fusion.share_level && counted(body_index_);
+  return subs_.has_body() && opt_.fusion.share_level && counted(subs_.body_index());
 }
 
 void Navigator::share_level() {
   if (!level_shared()) return;
-  const Vec3 rpy = body_->vehicle_rpy();
-  for (WheelIns* w : wheels_) w->set_vehicle_level(rpy.x(), rpy.y());
+  const Vec3 rpy = subs_.body().vehicle_rpy();
+  for (int i = 0; i < subs_.size(); ++i)
+    if (subs_.is_wheel(i)) subs_.wheel(i).set_vehicle_level(rpy.x(), rpy.y());
 }
 
-void Navigator::add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
-                                std::array<H3, kMaxCentralized>& h) const {
-  if (!level_shared() || c == 0.0) return;
-  h[body_index_].block<3, 3>(0, PHI) +=
-      c * H_level * vehicle_level_sensitivity(body_->C_VtoW());
+std::array<bool, kMaxModules> Navigator::in_use_mask() const {
+  std::array<bool, kMaxModules> use{};
+  for (int i = 0; i < subs_.size(); ++i) use[i] = in_use(i);
+  return use;
 }
 
-void Navigator::velocity_measurement(int i, JointMeasurement& jm) const {
-  // The same measurements as the distributed filter (eq. 5 for a Wheel-INS, eq. 6 for the
-  // Body-INS, with the fault handling's choice of speeds), but one EKF over all error states
-  // (Section VI-B-2), so every dependence on another IMU's state is in H instead of being
-  // ignored:
-  //  - the mean wheel speed (1/n) sum_j (-a_j r_j omega_x,j) over the wheels in the mean
-  //    (counted, speed usable: speeds_.in_mean, n = speeds_.n_mean) carries each of those
-  //    Wheel-IMUs' r delta omega_x of eq. (3): -(1/n) dspeed_j/d(b_g,x, s_g,x) in block j
-  //    (dz = z_hat - z_meas), also when it replaces a wheel's own unusable speed;
-  //  - a Wheel-INS model uses the Body-INS roll/pitch (eq. 5, theta_3 and phi_3): its
-  //    H_level times d(roll, pitch)/d(phi_3) in the Body-INS block.
-  // Everything is evaluated at the current state: the speeds from the current gyro-x
-  // estimates, the level from the current Body-INS attitude. Which speeds are usable is
-  // decided once per update epoch (velocity_updates()).
-  const int N = subsystem_count();
-  const SpeedSelection& sel = speeds_;
-  const int n_mean = sel.n_mean;
-  double mean_speed = 0.0;
-  Vec3 mean_point = Vec3::Zero();
-  for (int j = 0; j < N; ++j)
-    if (sel.in_mean[j]) {
-      const auto& w = static_cast<const WheelIns&>(*subs_[j]);
-      mean_speed += w.wheel_speed();
-      mean_point += w.module().p_inV;
-    }
-  if (n_mean) {
-    mean_speed /= n_mean;
-    mean_point /= n_mean;
-  }
-  for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
-  bool mean = false;  // the measured speed is the mean: its sensitivities are added below
-  if (subs_[i]->is_wheel()) {
-    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
-    WheelVelocityInput in = w.own_velocity_input();
-    if (level_shared()) {
-      const Vec3 rpy = body_->vehicle_rpy();
-      in.vehicle_roll = rpy.x();
-      in.vehicle_pitch = rpy.y();
-    }
-    jm.R = w.velocity_noise();
-    if (sel.speed_ok[i]) {
-      // Its own speed (in.dspeed_* stay this IMU's), or the mean it is part of.
-      mean = opt_.fusion.speed == SpeedSharing::kMean && n_mean > 1 && sel.in_mean[i];
-    } else if (n_mean > 0) {
-      mean = true;  // its own speed is unusable: the mean of the others'
-    } else {
-      // No speed at all: the NHC rows only.
-      in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
-      jm.R(0, 0) = kNoSpeedVar;
-    }
-    if (mean) {
-      in.measured_speed = mean_speed;
-      in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
-    }
-    const WheelVelocityModel m = wheel_velocity_model(in);
-    jm.H[i] = m.H;
-    add_level_block(m.H_level, 1.0, jm.H);
-    jm.dz = m.innovation();
-    if (mean) {
-      // The mean of the wheel speeds is the speed of the mean of the wheel centres (o for a
-      // left/right pair), not of this wheel's centre, which eq. (5) predicts: in a turn it is
-      // off by yaw rate x (offset of this wheel from that point), +-omega_z track / 2, up to
-      // five times the forward sigma. The distributed filter ignores it; the joint filter
-      // must not, or its position constraint turns the opposite left/right speed errors
-      // into a common heading error of every IMU (0.67 deg heading RMSE on error-free data).
-      // Counted as forward noise at the Wheel-IMU's current yaw rate (its rate without the
-      // spin about its axle c1 = C e_x), so H stays eq. (5)'s.
-      const Mat3 C = w.ekf().state().C_ItoW();
-      const Vec3 wv = C * w.ekf().omega_ib_b();
-      const double yaw_rate = (wv - wv.dot(C.col(0)) * C.col(0)).z();  // without the spin
-      const double e = yaw_rate * (mean_point - w.module().p_inV).norm();
-      jm.R(0, 0) += e * e;
-    }
-    jm.gate = w.velocity_gate();
-  } else {
-    // The mean speed of the wheels is the speed of the mean of their centres (o for a
-    // symmetric pair; the wheel centre itself for one wheel).
-    jm.R = body_->velocity_noise();
-    double speed = mean_speed;
-    mean = n_mean > 0;
-    if (!mean) {
-      speed = body_->ins_speed();
-      jm.R(0, 0) = kNoSpeedVar;
-      mean_point.setZero();
-    }
-    const BodyVelocityModel m = body_->velocity_model(speed, mean_point);
-    jm.H[i] = m.H;
-    jm.dz = m.innovation();
-    jm.gate = body_->velocity_gate();
-  }
-  if (mean)
-    for (int j = 0; j < N; ++j) {
-      if (!sel.in_mean[j]) continue;
-      const WheelIns::SpeedSensitivity ds =
-          static_cast<const WheelIns&>(*subs_[j]).speed_sensitivity();
-      jm.H[j](0, BG) -= ds.dbgx / n_mean;
-      jm.H[j](0, SG) -= ds.dsgx / n_mean;
-    }
+void Navigator::take_speeds(SharedInputs& sh, bool level_now) const {
+  take_level(subs_, level_shared(), level_now, sh);
+  take_wheel_inputs(subs_, in_use_mask(), sh);
+  take_mean_speed(subs_, speeds_, sh);
+}
+
+void Navigator::take_reference(SharedInputs& sh, bool level_now) const {
+  take_level(subs_, level_shared(), level_now, sh);
+  wheelins::take_reference(subs_, sh);
+}
+
+void Navigator::velocity_measurement(int i, Measurement& m) const {
+  SharedInputs sh;
+  take_speeds(sh, true);
+  wheelins::velocity_measurement(subs_, sh, opt_.fusion, i, filter_->joint(), m);
 }
 
 bool Navigator::reference_weights(std::array<double, kMaxModules>& k, int& n_ref,
@@ -349,7 +186,7 @@ bool Navigator::reference_weights(std::array<double, kMaxModules>& k, int& n_ref
   n_ref = n_tied = 0;
   for (int i = 0; i < n; ++i) {
     if (counted(i)) {
-      k[i] = weights_[i];
+      k[i] = subs_.weight(i);
       ksum += k[i];
       ++n_ref;
     }
@@ -360,66 +197,12 @@ bool Navigator::reference_weights(std::array<double, kMaxModules>& k, int& n_ref
   return true;
 }
 
-void Navigator::position_measurement(int i, JointMeasurement& jm) const {
-  std::array<double, kMaxModules> k{};
+void Navigator::position_measurement(int i, Measurement& m) const {
+  SharedInputs sh;
   int n_ref = 0, n_tied = 0;
-  reference_weights(k, n_ref, n_tied);
-  position_measurement(i, k, jm);
-}
-
-void Navigator::position_measurement(int i, const std::array<double, kMaxModules>& k,
-                                     JointMeasurement& jm) const {
-  // dz_i = r_o^i - sum_j k_j r_o^j (eq. 9, 12) depends on every counted subsystem's state:
-  // (1 - k_i) H_i in block i and -k_j H_j in the others, and, through the level a Wheel-INS
-  // uses in C_v^w (eq. 8), on the Body-INS attitude.
-  const int N = subsystem_count();
-  Vec3 level = Vec3::Zero();
-  const bool shared = level_shared();
-  if (shared) level = body_->vehicle_rpy();
-  Vec3 fused = Vec3::Zero(), own = Vec3::Zero();
-  for (int j = 0; j < kMaxCentralized; ++j) jm.H[j].setZero();
-  for (int j = 0; j < N; ++j) {
-    const double c = (j == i ? 1.0 : 0.0) - k[j];
-    if (c == 0.0 && k[j] == 0.0) continue;  // neither this module nor in the reference
-    ReferencePointInput in = subs_[j]->reference_point_input();
-    if (shared && in.wheel) {
-      in.vehicle_roll = level.x();
-      in.vehicle_pitch = level.y();
-    }
-    const ReferencePointModel m = reference_point_model(in);
-    jm.H[j] += c * m.H;
-    if (in.wheel) add_level_block(m.H_level, c, jm.H);
-    fused += k[j] * m.r_o;
-    if (j == i) own = m.r_o;
-  }
-  jm.dz = own - fused;
-  const double sd = opt_.fusion.position_std;
-  jm.R = Mat3::Identity() * sd * sd;
-  jm.gate = opt_.fusion.position_gate;
-}
-
-void Navigator::propagate_joint(int i) {
-  StrapdownEkf& ekf = subs_[i]->ekf();
-  if (ekf.pending_dt() <= 0.0) return;
-  joint_->propagate(i, ekf.pending_dynamics(), ekf.noise(), ekf.pending_dt());
-  ekf.clear_pending();
-}
-
-void Navigator::flush_covariances() {
-  for (int i = 0; i < subsystem_count(); ++i) {
-    if (joint_) propagate_joint(i);
-    else subs_[i]->ekf().flush_covariance();
-  }
-}
-
-UpdateReport Navigator::fuse_joint(const JointMeasurement& m) {
-  std::array<const H3*, kMaxCentralized> blocks{};
-  for (int j = 0; j < subsystem_count(); ++j) blocks[j] = &m.H[j];
-  std::array<Vec21, kMaxCentralized> dx;
-  const UpdateReport rep = joint_->update(blocks, m.dz, m.R, m.gate, dx);
-  if (rep.accepted)
-    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
-  return rep;
+  reference_weights(sh.k, n_ref, n_tied);
+  take_reference(sh, true);
+  wheelins::position_measurement(subs_, sh, opt_.fusion, i, m);
 }
 
 void Navigator::count_velocity_update(int i, const UpdateReport& rep, double t_now) {
@@ -453,32 +236,27 @@ void Navigator::velocity_updates() {
   share_level();
   // Which wheel speeds can be used: not saturated, and (fault handling on) agreeing with
   // the wheel's own INS to within speed_gate sigma of the predicted forward velocity.
-  const int n_sub = subsystem_count();
+  const int n_sub = subs_.size();
+  SharedInputs& sh = shared_;
+  take_level(subs_, level_shared(), false, sh);
+  take_wheel_inputs(subs_, in_use_mask(), sh);
   SpeedSelection& sel = speeds_;
   sel = SpeedSelection();
   std::array<bool, kMaxModules> saturated{};
   excused_.fill(false);
-  std::array<WheelVelocityInput, kMaxModules> own;
-  int& n_mean = sel.n_mean;
-  double mean_speed = 0.0;
-  Vec3 mean_point = Vec3::Zero();
   for (int i = 0; i < n_sub; ++i) {
-    if (!subs_[i]->is_wheel() || !in_use(i)) continue;
-    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
-    own[i] = w.own_velocity_input();
+    if (!subs_.is_wheel(i) || !in_use(i)) continue;
     if (handle && t_now < rt_[i].saturated_until) saturated[i] = true;
     sel.speed_ok[i] = !saturated[i];
     // Saturated, or shortly after: its INS is off for a known reason, not a fault.
     if (handle && t_now - rt_[i].saturated_until < opt_.faults.retry_after) excused_[i] = true;
   }
-  if (handle) check_wheel_speeds(t_now, own, sel.speed_ok);
+  if (handle) check_wheel_speeds(t_now, sh.wheel, sel.speed_ok);
   for (int i = 0; i < n_sub; ++i) {
-    if (!subs_[i]->is_wheel() || !in_use(i)) continue;
+    if (!subs_.is_wheel(i) || !in_use(i)) continue;
     if (sel.speed_ok[i] && counted(i)) {
       sel.in_mean[i] = true;
-      ++n_mean;
-      mean_speed += own[i].measured_speed;
-      mean_point += subs_[i]->module().p_inV;
+      ++sel.n_mean;
     }
   }
   // Every wheel saturated: their clipped speeds (lower bounds) are better than none, and
@@ -486,95 +264,43 @@ void Navigator::velocity_updates() {
   {
     bool any_excused = false, any_clean = false;
     for (int i = 0; i < n_sub; ++i)
-      if (subs_[i]->is_wheel() && in_use(i)) (excused_[i] ? any_excused : any_clean) = true;
+      if (subs_.is_wheel(i) && in_use(i)) (excused_[i] ? any_excused : any_clean) = true;
     degraded_ = any_excused && !any_clean;
   }
-  if (n_mean == 0)
+  if (sel.n_mean == 0)
     for (int i = 0; i < n_sub; ++i)
       if (saturated[i] && counted(i)) {
         sel.speed_ok[i] = sel.in_mean[i] = true;
-        ++n_mean;
-        mean_speed += own[i].measured_speed;
-        mean_point += subs_[i]->module().p_inV;
+        ++sel.n_mean;
       }
-  if (joint_) {
-    // Sequential updates, each evaluated at the state the previous one left (the joint
-    // correction moves every IMU's errors); the speed selection stays the epoch's.
-    JointMeasurement& m = joint_scratch_;
-    for (int i = 0; i < n_sub; ++i) {
-      if (!in_use(i)) continue;
-      share_level();
-      velocity_measurement(i, m);
-      count_velocity_update(i, fuse_joint(m), t_now);
-    }
-    return;
-  }
-  if (n_mean) {
-    mean_speed /= n_mean;
-    mean_point /= n_mean;
-  }
+  take_mean_speed(subs_, sel, sh);
+  // The distributed filter's updates all use the epoch's shared quantities; the centralized
+  // filter's sequential updates each see the state the previous one left (the joint
+  // correction moves every IMU's errors), with the epoch's speed selection.
+  const bool joint = filter_->joint();
   for (int i = 0; i < n_sub; ++i) {
     if (!in_use(i)) continue;
-    if (subs_[i]->is_wheel()) {
-      const auto& w = static_cast<const WheelIns&>(*subs_[i]);
-      WheelVelocityInput in = own[i];
-      Mat3 R = w.velocity_noise();
-      if (sel.speed_ok[i]) {
-        if (opt_.fusion.speed == SpeedSharing::kMean && n_mean > 1 && counted(i)) {
-          // Its own speed enters the mean with weight 1/n.
-          in.measured_speed = mean_speed;
-          in.dspeed_dbgx /= n_mean;
-          in.dspeed_dsgx /= n_mean;
-        }
-      } else if (n_mean > 0) {
-        // Its own speed is unusable: the others' (independent of its states).
-        in.measured_speed = mean_speed;
-        in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
-      } else {
-        // No speed at all: the NHC rows only.
-        in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
-        R(0, 0) = kNoSpeedVar;
-      }
-      const WheelVelocityModel m = wheel_velocity_model(in);
-      count_velocity_update(i, fuse(i, m.H, m.innovation(), R, w.velocity_gate()), t_now);
-    } else {
-      // The mean speed of the wheels is the speed of the mean of their centres (o for a
-      // symmetric pair; the wheel centre itself for one wheel).
-      Mat3 R = body_->velocity_noise();
-      double speed = mean_speed;
-      if (n_mean == 0) {
-        speed = body_->ins_speed();
-        R(0, 0) = kNoSpeedVar;
-        mean_point.setZero();
-      }
-      const BodyVelocityModel m = body_->velocity_model(speed, mean_point);
-      count_velocity_update(i, fuse(i, m.H, m.innovation(), R, body_->velocity_gate()), t_now);
+    if (joint) {
+      share_level();
+      take_speeds(sh, false);
     }
+    wheelins::velocity_measurement(subs_, sh, opt_.fusion, i, joint, meas_);
+    count_velocity_update(i, filter_->fuse(meas_), t_now);
   }
-}
-
-UpdateReport Navigator::fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate) {
-  if (!joint_) return subs_[i]->ekf().update<3>(H, dz, R, gate);
-  std::array<const H3*, kMaxCentralized> blocks{};
-  blocks[i] = &H;
-  std::array<Vec21, kMaxCentralized> dx;
-  const UpdateReport rep = joint_->update(blocks, dz, R, gate, dx);
-  if (rep.accepted)
-    for (int j = 0; j < subsystem_count(); ++j) subs_[j]->ekf().feedback(dx[j]);
-  return rep;
 }
 
 Mat21 Navigator::covariance(int i) const {
-  return joint_ ? joint_->block(i) : subs_[i]->ekf().covariance();
+  Mat21 scratch;
+  return filter_->covariance(i, scratch);
 }
 
 void Navigator::position_update() {
-  // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 9) is the
+  // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 8) is the
   // reference; modules on probation are tied to it without moving it.
-  const int n = subsystem_count();
-  std::array<double, kMaxModules> k{};
+  const int n = subs_.size();
+  SharedInputs& sh = shared_;
   int n_ref = 0, n_tied = 0;
-  const bool have_ref = reference_weights(k, n_ref, n_tied);
+  const bool have_ref = reference_weights(sh.k, n_ref, n_tied);
   if (opt_.faults.enabled) check_headings(min_time());
   if (!have_ref || n_tied < 2) return;
   auto record = [&](const UpdateReport& rep) {
@@ -584,39 +310,28 @@ void Navigator::position_update() {
   };
   auto receives = [&](int i) {
     // A lone reference module is not constrained by itself.
-    return (!opt_.faults.enabled || faults_.tied(i)) && !(n_ref == 1 && k[i] > 0.0);
+    return (!opt_.faults.enabled || faults_.tied(i)) && !(n_ref == 1 && sh.k[i] > 0.0);
   };
-  if (joint_) {
-    // Sequentially, each re-evaluated at the state the previous one left.
-    JointMeasurement& m = joint_scratch_;
-    for (int i = 0; i < n; ++i) {
-      if (!receives(i)) continue;
-      share_level();
-      position_measurement(i, k, m);
-      record(fuse_joint(m));
-    }
-    return;
-  }
-  std::vector<ReferencePointModel>& models = rp_models_;
-  Vec3 fused = Vec3::Zero();
-  for (int i = 0; i < n; ++i) {
-    models[i] = reference_point_model(subs_[i]->reference_point_input());
-    fused += k[i] * models[i].r_o;
-  }
-  const double sd = opt_.fusion.position_std;
-  const Mat3 R = Mat3::Identity() * sd * sd;
+  // Distributed: every subsystem's o at the level the Wheel-INSs were last given; centralized:
+  // each update re-evaluated at the state the previous one left.
+  const bool joint = filter_->joint();
+  if (!joint) take_reference(sh, false);
   for (int i = 0; i < n; ++i) {
     if (!receives(i)) continue;
-    const Vec3 dz = models[i].r_o - fused;
-    record(subs_[i]->ekf().update<3>(models[i].H, dz, R, opt_.fusion.position_gate));
+    if (joint) {
+      share_level();
+      take_reference(sh, false);
+    }
+    wheelins::position_measurement(subs_, sh, opt_.fusion, i, meas_);
+    record(filter_->fuse(meas_));
   }
 }
 
 TrajectoryRecord Navigator::subsystem_record(int i, bool with_lla) const {
-  const Subsystem& s = *subs_[i];
+  const Subsystem& s = subs_[i];
   const StrapdownEkf& ekf = s.ekf();
-  Mat21 joint_block;
-  const Mat21& P = joint_ ? (joint_block = joint_->block(i)) : ekf.covariance();
+  Mat21 scratch;
+  const Mat21& P = filter_->covariance(i, scratch);
   TrajectoryRecord r;
   r.t = ekf.state().t;
   const ReferencePointModel m = reference_point_model(s.reference_point_input());
@@ -627,11 +342,12 @@ TrajectoryRecord Navigator::subsystem_record(int i, bool with_lla) const {
   const Eigen::RowVector3d J = s.heading_sensitivity();
   const double var_psi = J * P.block<3, 3>(PHI, PHI) * J.transpose();
   if (!s.is_wheel()) {
-    r.rpy = static_cast<const BodyIns&>(s).vehicle_rpy();
+    r.rpy = subs_.body().vehicle_rpy();
     r.rpy_std.head<2>() = P.block<2, 2>(PHI, PHI).diagonal().cwiseSqrt();
   } else {
     r.rpy = Vec3(0.0, 0.0, s.vehicle_heading());
-    if (body_ && opt_.fusion.share_level) r.rpy.head<2>() = body_->vehicle_rpy().head<2>();
+    if (subs_.has_body() && opt_.fusion.share_level)
+      r.rpy.head<2>() = subs_.body().vehicle_rpy().head<2>();
   }
   r.rpy_std.z() = std::sqrt(std::max(0.0, var_psi));
   // diag(H P H^T) over the columns eq. (8) depends on: H = [I 0 A 0 ...] over (dr, dv, phi),
@@ -684,8 +400,8 @@ void Navigator::write_records(double t) {
   if (modules_out)
     for (int i = 0; i < n; ++i)
       // A module whose data have stopped (not yet declared out) has nothing new.
-      if (in_use(i) && subs_[i]->time() > rt_[i].last_record_t) {
-        rt_[i].last_record_t = subs_[i]->time();
+      if (in_use(i) && subs_[i].time() > rt_[i].last_record_t) {
+        rt_[i].last_record_t = subs_[i].time();
         out_recs_[i].lla = frame_.geodetic_from_ned(out_recs_[i].p_inN);
         sink_(i + 1, out_recs_[i]);
       }
@@ -706,7 +422,7 @@ TrajectoryRecord Navigator::fuse_records(const std::array<bool, kMaxModules>& us
   for (int i = 0; i < subsystem_count(); ++i)
     if (use[i]) {
       ++n_use;
-      ksum += weights_[i];
+      ksum += subs_.weight(i);
     }
   TrajectoryRecord r = recs[first_used(use)];
   if (subs_.size() == 1 || n_use <= 1) {
@@ -721,9 +437,9 @@ TrajectoryRecord Navigator::fuse_records(const std::array<bool, kMaxModules>& us
   int body_index = -1;
   for (int i = 0; i < subsystem_count(); ++i) {
     if (!use[i]) continue;
-    if (subs_[i].get() == body_) body_index = i;
+    if (i == subs_.body_index()) body_index = i;
     const TrajectoryRecord& ri = recs[i];
-    const double k = weights_[i] / ksum;
+    const double k = subs_.weight(i) / ksum;
     p += k * ri.p_inN;
     v += k * ri.v_inN;
     p_std += k * ri.p_std;
@@ -740,7 +456,7 @@ TrajectoryRecord Navigator::fuse_records(const std::array<bool, kMaxModules>& us
   r.rpy.z() = std::atan2(s, c);
   r.rpy_std.z() = psi_std;
   if (body_index >= 0) {
-    const Vec3 rpy = body_->vehicle_rpy();
+    const Vec3 rpy = subs_.body().vehicle_rpy();
     r.rpy.head<2>() = rpy.head<2>();
   }
   return r;
@@ -766,16 +482,16 @@ bool Navigator::substitute_speed(int wheel_index, double* speed) const {
   // Only another wheel's gyro measures the speed independently (one that has not been
   // saturated for a while: a wheel at the edge of saturation flickers in and out); with
   // every wheel saturated the clipped readings (a lower bound) are all there is.
-  const double t = subs_[wheel_index]->time();
+  const double t = subs_[wheel_index].time();
   double sum = 0.0;
   int n = 0;
   for (int j = 0; j < subsystem_count(); ++j)
-    if (j != wheel_index && subs_[j]->is_wheel() && counted(j) &&
+    if (j != wheel_index && subs_.is_wheel(j) && counted(j) &&
         t - rt_[j].saturated_until > kSaturationFree) {
       // Moved to this wheel: v_i = v_j - yaw_rate (y_i - y_j) (v-frame y to the right).
-      const auto& wj = static_cast<const WheelIns&>(*subs_[j]);
+      const auto& wj = subs_.wheel(j);
       sum += wj.wheel_speed() -
-             wj.yaw_rate() * (subs_[wheel_index]->module().p_inV.y() - wj.module().p_inV.y());
+             wj.yaw_rate() * (subs_[wheel_index].module().p_inV.y() - wj.module().p_inV.y());
       ++n;
     }
   if (n) *speed = sum / n;
@@ -783,7 +499,7 @@ bool Navigator::substitute_speed(int wheel_index, double* speed) const {
 }
 
 void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b) {
-  const double full = opt_.faults.saturation_margin * subs_[index]->module().gyro_range * raw.dt;
+  const double full = opt_.faults.saturation_margin * subs_[index].module().gyro_range * raw.dt;
   if (!(raw.dtheta.cwiseAbs().maxCoeff() >= full)) return;
   Runtime& rt = rt_[index];
   ++faults_.stats(index).saturated_samples;
@@ -793,7 +509,7 @@ void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b)
     rt.saturation_reported = true;
     char what[128];
     std::snprintf(what, sizeof what, "gyro at full scale (%.0f deg/s)",
-                  subs_[index]->module().gyro_range / kDeg);
+                  subs_[index].module().gyro_range / kDeg);
     faults_.note(index, raw.t, what,
                  substituted ? "axle rate from the other wheels' speed; own speed not used"
                              : "no unsaturated wheel: clipped reading kept (speed is a lower "
@@ -807,8 +523,8 @@ void Navigator::handle_saturation(int index, const ImuSample& raw, ImuSample& b)
   // estimates) holds the substituted rate too. (Putting the scale factor back as well,
   // (1 + s_g,x), made the saturation test worse: 3.3 % drift instead of 1.2 %.)
   // The reading says the wheel turns at least at full scale.
-  const auto& w = static_cast<const WheelIns&>(*subs_[index]);
-  const double floor = subs_[index]->module().gyro_range * subs_[index]->module().wheel_radius;
+  const auto& w = subs_.wheel(index);
+  const double floor = subs_[index].module().gyro_range * subs_[index].module().wheel_radius;
   const double v_sub = std::abs(v) >= floor ? v : std::copysign(floor, v);
   b.dtheta.x() = (w.omega_x_at_speed(v_sub) + w.ekf().errors().bg.x()) * b.dt;
 }
@@ -826,8 +542,8 @@ void Navigator::check_wheel_speeds(double t, const std::array<WheelVelocityInput
   int n_u = 0;
   double yaw_rate = 0.0;
   for (int i = 0; i < n; ++i) {
-    if (!speed_ok[i] || !subs_[i]->is_wheel()) continue;
-    const auto& w = static_cast<const WheelIns&>(*subs_[i]);
+    if (!speed_ok[i] || !subs_.is_wheel(i)) continue;
+    const auto& w = subs_.wheel(i);
     const WheelVelocityModel m = wheel_velocity_model(own[i]);
     const Mat21 P = covariance(i);
     const double s_xx = m.H.row(0) * P * m.H.row(0).transpose() + w.velocity_noise()(0, 0);
@@ -839,12 +555,12 @@ void Navigator::check_wheel_speeds(double t, const std::array<WheelVelocityInput
   yaw_rate /= n_u;
   int suspect = -1;
   for (int i = 0; i < n; ++i) {
-    if (!speed_ok[i] || !subs_[i]->is_wheel()) continue;
-    const double vi = own[i].measured_speed, yi = subs_[i]->module().p_inV.y();
+    if (!speed_ok[i] || !subs_.is_wheel(i)) continue;
+    const double vi = own[i].measured_speed, yi = subs_[i].module().p_inV.y();
     double pred = 0.0;
     for (int j = 0; j < n; ++j)
-      if (j != i && speed_ok[j] && subs_[j]->is_wheel())
-        pred += own[j].measured_speed - yaw_rate * (yi - subs_[j]->module().p_inV.y());
+      if (j != i && speed_ok[j] && subs_.is_wheel(j))
+        pred += own[j].measured_speed - yaw_rate * (yi - subs_[j].module().p_inV.y());
     pred /= n_u - 1;
     bool disagrees = z[i] > opt_.faults.speed_gate &&
                      std::abs(vi - pred) > std::max(opt_.faults.wheel_mismatch, 0.1 * std::abs(pred));
@@ -852,7 +568,7 @@ void Navigator::check_wheel_speeds(double t, const std::array<WheelVelocityInput
     if (disagrees && (suspect < 0 || z[i] > z[suspect])) suspect = i;
   }
   for (int i = 0; i < n; ++i) {
-    if (!speed_ok[i] || !subs_[i]->is_wheel()) continue;
+    if (!speed_ok[i] || !subs_.is_wheel(i)) continue;
     Runtime& rt = rt_[i];
     if (i == suspect) {
       speed_ok[i] = false;
@@ -877,8 +593,8 @@ void Navigator::fault_housekeeping(double t) {
   for (int i = 0; i < subsystem_count(); ++i) {
     Runtime& rt = rt_[i];
     if (faults_.counts(i) && t - rt.snapshot_t >= kSnapshotInterval) {
-      rt.errors_old = rt.have_snapshot ? rt.errors_new : subs_[i]->ekf().errors();
-      rt.errors_new = subs_[i]->ekf().errors();
+      rt.errors_old = rt.have_snapshot ? rt.errors_new : subs_[i].ekf().errors();
+      rt.errors_new = subs_[i].ekf().errors();
       rt.snapshot_t = t;
       rt.have_snapshot = true;
     }
@@ -917,10 +633,10 @@ void Navigator::check_headings(double t) {
     double s = 0.0, c = 0.0;
     for (int j = 0; j < n; ++j)
       if (j != i && faults_.counts(j)) {
-        s += weights_[j] * std::sin(subs_[j]->vehicle_heading());
-        c += weights_[j] * std::cos(subs_[j]->vehicle_heading());
+        s += subs_.weight(j) * std::sin(subs_[j].vehicle_heading());
+        c += subs_.weight(j) * std::cos(subs_[j].vehicle_heading());
       }
-    d[i] = std::abs(wrap_pi(subs_[i]->vehicle_heading() - std::atan2(s, c)));
+    d[i] = std::abs(wrap_pi(subs_[i].vehicle_heading() - std::atan2(s, c)));
     if (worst < 0 || d[i] > d[worst]) worst = i;
   }
   for (int i = 0; i < n; ++i) {
@@ -975,11 +691,11 @@ void Navigator::restart(int i, double t) {
   if (rt_[i].revert_errors && rt_[i].have_snapshot) {
     // The sensor-error estimates learnt while the fault went undetected are not trusted:
     // back to those of 10-20 s before the detection.
-    subs_[i]->ekf().set_errors(rt_[i].errors_old);
+    subs_[i].ekf().set_errors(rt_[i].errors_old);
   }
   rt_[i].revert_errors = false;
-  subs_[i]->restart(rt_[i].realign.mean_f_now(), fix);
-  if (joint_) joint_->reset(i, subs_[i]->ekf().covariance());
+  subs_[i].restart(rt_[i].realign.mean_f_now(), fix);
+  filter_->restarted(i);
   faults_.clear_tests(i);
   ++faults_.stats(i).restarts;
   rt_[i].detector_fired = false;

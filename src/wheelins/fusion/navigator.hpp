@@ -17,88 +17,19 @@
 #include <string>
 #include <vector>
 
-#include "wheelins/filter/body_ins.hpp"
-#include "wheelins/filter/wheel_ins.hpp"
-#include "wheelins/fusion/centralized.hpp"
 #include "wheelins/fusion/fault_monitor.hpp"
+#include "wheelins/fusion/filter_backend.hpp"
+#include "wheelins/fusion/measurement.hpp"
+#include "wheelins/fusion/options.hpp"
+#include "wheelins/fusion/subsystems.hpp"
 #include "wheelins/nav/trajectory_record.hpp"
 #include "wheelins/nav/vehicle.hpp"
 
 namespace wheelins {
 
-/// How the Wheel-INSs get their forward speed.
-enum class SpeedSharing {
-  kMean,  ///< the paper: the mean of all Wheel-IMU speeds, for every subsystem
-  kOwn,   ///< each Wheel-INS its own wheel's speed; a Body-INS the mean, at the mean wheel point
-};
-
-struct FusionOptions {
-  SpeedSharing speed = SpeedSharing::kMean;
-  bool share_level = true;                ///< Body-INS roll/pitch to the Wheel-INSs
-  bool position_constraint = true;
-  double position_update_interval = 1.0;  ///< [s]; the paper's 1 Hz
-  double position_std = 0.2;              ///< [m] (Table 9)
-  double position_gate = 0.0;             ///< test-ratio gate; 0 = off
-  std::vector<double> weights;            ///< k_i of eq. (9); empty = equal
-  /// One joint covariance over all IMUs (Section VI-B-2) instead of one per subsystem.
-  bool centralized = false;
-};
-
-struct NavigatorOptions {
-  WheelInsOptions wheel;
-  BodyInsOptions body;
-  FusionOptions fusion;
-  MechanizationOptions::Method mechanization = MechanizationOptions::Method::kRotationExact;
-  /// Compensate the earth rotation (the manifest says whether the data contain it).
-  bool earth_rotation = true;
-  /// Sensor-fault handling: outages, saturation, slip, isolation of faulty IMUs.
-  FaultOptions faults;
-  /// Output interval [s]; 0 = every epoch of the first module.
-  double output_interval = 0.0;
-  /// Also send each subsystem's own solution to the sink (streams 1..N) of a multi-IMU run.
-  bool module_records = true;
-  /// Covariance time update every this many seconds, F integrated over the epochs in
-  /// between (StrapdownEkf::set_covariance_interval); 0 = every IMU epoch. Measurement
-  /// updates always see P propagated to their epoch.
-  double covariance_interval = 0.05;
-  /// The options in human units (OpenVINS style), one per line.
-  std::string describe() const;
-};
-
-/// Counters and timing of a run.
-struct NavigatorStats {
-  std::uint64_t samples = 0;            ///< samples given to process()
-  std::uint64_t epochs = 0;             ///< navigation epochs of the first module
-  std::uint64_t velocity_updates = 0;   ///< per subsystem, summed
-  std::uint64_t velocity_rejected = 0;  ///< refused by the innovation gate
-  std::uint64_t position_updates = 0;
-  std::uint64_t position_rejected = 0;
-  std::uint64_t records = 0;
-  double t_start = 0.0, t_end = 0.0;    ///< navigation interval [s]
-  double max_velocity_test_ratio = 0.0;
-  double max_position_test_ratio = 0.0;
-  /// Time spent in the velocity-update and position-constraint steps (all subsystems) and
-  /// their number of occurrences, for the paper's Table 8 [s].
-  double velocity_step_seconds = 0.0, position_step_seconds = 0.0;
-  std::uint64_t velocity_steps = 0, position_steps = 0;
-  /// Covariance health, checked at every velocity-update step for every subsystem in use:
-  /// checks, failures of the Cholesky test (not positive definite), and the largest
-  /// asymmetry max|P - P^T| / max|P| seen.
-  std::uint64_t covariance_checks = 0, covariance_not_pd = 0;
-  double max_covariance_asymmetry = 0.0;
-};
-
-/// One measurement of the centralized filter: dz = sum_j H[j] dx_j + e, e ~ N(0, R).
-struct JointMeasurement {
-  std::array<H3, kMaxCentralized> H;
-  Vec3 dz = Vec3::Zero();
-  Mat3 R = Mat3::Identity();
-  double gate = 0.0;
-};
-
 class Navigator {
  public:
-  static constexpr int kMaxModules = 16;
+  static constexpr int kMaxModules = wheelins::kMaxModules;
   /// Receives records: stream 0 is the vehicle (the fused solution), streams 1..N the
   /// subsystems' own solutions (only when N > 1).
   using Sink = std::function<void(int stream, const TrajectoryRecord&)>;
@@ -116,16 +47,17 @@ class Navigator {
 
   bool navigating() const { return navigating_; }
   const NavigatorStats& stats() const { return stats_; }
-  int subsystem_count() const { return static_cast<int>(subs_.size()); }
-  const Subsystem& subsystem(int i) const { return *subs_.at(i); }
-  Subsystem& subsystem(int i) { return *subs_.at(i); }
-  /// The centralized filter's measurements of subsystem i at the current state (also
-  /// usable without a joint covariance, for checking them): the velocity + NHC update
-  /// (eq. 5/6) and the position constraint (eq. 12), H with a block for every IMU.
-  /// With fault handling, only the modules that count enter the mean wheel speed and the
-  /// reference (the velocity measurement uses the speed selection of the last update epoch).
-  void velocity_measurement(int i, JointMeasurement& m) const;
-  void position_measurement(int i, JointMeasurement& m) const;
+  int subsystem_count() const { return subs_.size(); }
+  const Subsystem& subsystem(int i) const { return subs_.at(i); }
+  Subsystem& subsystem(int i) { return subs_.at(i); }
+  /// The measurements of subsystem i as this navigator's filter would fuse them now, at the
+  /// current state (the Body-INS level as it is now), H with a block for every IMU
+  /// (measurement.hpp): the velocity + NHC update (eq. 5/6) and the position constraint
+  /// (eq. 11). With fault handling, only the modules that count enter the mean wheel speed
+  /// and the reference (the velocity measurement uses the speed selection of the last
+  /// update epoch).
+  void velocity_measurement(int i, Measurement& m) const;
+  void position_measurement(int i, Measurement& m) const;
   /// The fused vehicle solution now.
   TrajectoryRecord vehicle_record() const;
   /// Health, counters and the report of detected faults.
@@ -135,41 +67,24 @@ class Navigator {
 
  private:
   void start_navigation(double t0);
-  /// Forward variance of a velocity row that carries no speed [m^2/s^2].
-  static constexpr double kNoSpeedVar = 1e4;
-  /// The wheel speeds an update epoch uses: speed_ok (in use, not saturated, agreeing with
-  /// its own INS) and in_mean (also counted: the wheels whose speeds make the mean).
-  struct SpeedSelection {
-    std::array<bool, kMaxModules> speed_ok{}, in_mean{};
-    int n_mean = 0;
-  };
-  /// Velocity updates of every module in use; in the centralized filter H also carries the
-  /// other IMUs' blocks (velocity_measurement()). Like position_update(), it expects every
-  /// covariance at the current epoch (process() calls flush_covariances() first).
+  /// Velocity updates of every module in use (the measurements of measurement.hpp, fused by
+  /// the filter back-end). Like position_update(), it expects every covariance at the
+  /// current epoch (process() flushes them first).
   void velocity_updates();
   void count_velocity_update(int i, const UpdateReport& rep, double t_now);
   /// The Body-INS level is shared: sharing on and the Body-INS counted.
   bool level_shared() const;
   /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
   void share_level();
-  /// The reference weights k (eq. 9) renormalised over the counted modules (0 for the
+  std::array<bool, kMaxModules> in_use_mask() const;
+  /// The shared quantities of the velocity step (speeds_ selection) and of the position step
+  /// (sh.k weights), at the current state; `level_now`: see SharedInputs::level_now.
+  void take_speeds(SharedInputs& sh, bool level_now) const;
+  void take_reference(SharedInputs& sh, bool level_now) const;
+  /// The reference weights k (eq. 8) renormalised over the counted modules (0 for the
   /// others); false when no module counts.
   bool reference_weights(std::array<double, kMaxModules>& k, int& n_ref, int& n_tied) const;
-  void position_measurement(int i, const std::array<double, kMaxModules>& k,
-                            JointMeasurement& m) const;
-  /// Adds, to the Body-INS block of a joint H, the dependence of a Wheel-INS measurement on
-  /// the shared level: H_level * d(roll, pitch)/d(phi_body), scaled by `c`.
-  void add_level_block(const Eigen::Matrix<double, 3, 2>& H_level, double c,
-                       std::array<H3, kMaxCentralized>& h) const;
-  /// Fuses a joint measurement into the joint covariance and feeds every subsystem back.
-  UpdateReport fuse_joint(const JointMeasurement& m);
-  /// Moves subsystem i's accumulated dynamics into the joint covariance.
-  void propagate_joint(int i);
-  /// Every covariance (own or joint) propagated to the current epoch.
-  void flush_covariances();
   void position_update();
-  /// Fuses dz = H dx_i + e into subsystem i (distributed) or the joint state (centralized).
-  UpdateReport fuse(int i, const H3& H, const Vec3& dz, const Mat3& R, double gate);
   Mat21 covariance(int i) const;
   /// Subsystem i's own solution; without lat/lon/h (left NaN) when with_lla is false.
   TrajectoryRecord subsystem_record(int i, bool with_lla = true) const;
@@ -221,21 +136,17 @@ class Navigator {
   VehicleFix vehicle_fix(int i, double t) const;
   void fault_housekeeping(double t);
 
-  VehicleSetup setup_;
-  std::vector<std::string> sources_;  ///< per subsystem: where its samples come from
   NavigatorOptions opt_;
   Sink sink_;
   earth::LocalFrame frame_;
-  std::vector<std::unique_ptr<Subsystem>> subs_;
-  std::vector<WheelIns*> wheels_;
-  BodyIns* body_ = nullptr;
-  int body_index_ = -1;  ///< position of the Body-INS in subs_
-  std::vector<double> weights_;
+  std::string source_;  ///< where the setup came from (messages)
+  double static_start_, static_end_, initial_heading_;
+  Subsystems subs_;
+  std::unique_ptr<FilterBackend> filter_;
   std::vector<StaticAccumulator> static_;
-  std::vector<ReferencePointModel> rp_models_;  ///< scratch of position_update(), sized once
-  std::unique_ptr<JointCovariance> joint_;
-  JointMeasurement joint_scratch_;  ///< of the centralized updates
-  SpeedSelection speeds_;           ///< the wheel speeds usable at the last update epoch
+  SharedInputs shared_;    ///< scratch of the update steps (no allocation per epoch)
+  Measurement meas_;       ///< scratch of the update steps
+  SpeedSelection speeds_;  ///< the wheel speeds usable at the last update epoch
   FaultMonitor faults_;
   bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
   std::array<bool, kMaxModules> excused_{};  ///< saturated or recovering this epoch

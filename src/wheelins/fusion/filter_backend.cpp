@@ -1,0 +1,39 @@
+#include "wheelins/fusion/filter_backend.hpp"
+
+#include "wheelins/fusion/centralized.hpp"
+
+namespace wheelins {
+
+namespace {
+
+/// The paper's filter: one EKF per subsystem, each owning its covariance.
+class DistributedFilter final : public FilterBackend {
+ public:
+  explicit DistributedFilter(Subsystems& subs) : subs_(subs) {}
+  bool joint() const override { return false; }
+  void start() override {}
+  void propagated(int i) override {
+    StrapdownEkf& ekf = subs_[i].ekf();
+    if (ekf.covariance_due()) ekf.flush_covariance();
+  }
+  void flush() override {
+    for (int i = 0; i < subs_.size(); ++i) subs_[i].ekf().flush_covariance();
+  }
+  const Mat21& covariance(int i, Mat21&) const override { return subs_[i].ekf().covariance(); }
+  UpdateReport fuse(const Measurement& m) override {
+    return subs_[m.module].ekf().update<3>(m.H_own, m.dz, m.R, m.gate);
+  }
+  void restarted(int) override {}
+
+ private:
+  Subsystems& subs_;
+};
+
+}  // namespace
+
+std::unique_ptr<FilterBackend> make_filter_backend(Subsystems& subs, bool centralized) {
+  if (centralized && subs.size() > 1) return std::make_unique<CentralizedFilter>(subs);
+  return std::make_unique<DistributedFilter>(subs);
+}
+
+}  // namespace wheelins

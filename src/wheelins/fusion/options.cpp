@@ -1,0 +1,60 @@
+#include "wheelins/fusion/options.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace wheelins {
+
+std::string NavigatorOptions::describe() const {
+  std::ostringstream o;
+  auto onoff = [](bool b) { return b ? "on" : "off"; };
+  o << "velocity update interval:   " << wheel.velocity_update_interval << " s\n"
+    << "wheel speed window:         " << wheel.speed_window << " s\n"
+    << "wheel speed sharing:        "
+    << (fusion.speed == SpeedSharing::kMean ? "mean of Wheel-IMUs (paper)" : "own wheel") << "\n"
+    << "Wheel-INS velocity sigma:   " << wheel.velocity_std.transpose() << " m/s\n"
+    << "Body-INS velocity sigma:    " << body.velocity_std.transpose() << " m/s\n"
+    << "position constraint:        " << onoff(fusion.position_constraint) << ", every "
+    << fusion.position_update_interval << " s, sigma " << fusion.position_std << " m\n"
+    << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
+    << "filter structure:           "
+    << (fusion.centralized ? "centralized (one joint covariance)" : "distributed (paper)") << "\n"
+    << "innovation gates (vel/pos): " << wheel.gate << " / " << fusion.position_gate
+    << " (0 = off)\n"
+    << "initial sigma:              position " << wheel.init.position << " m, velocity "
+    << wheel.init.velocity << " m/s, roll/pitch " << wheel.init.roll_pitch / kDeg
+    << " deg, heading " << wheel.init.heading / kDeg << " deg\n"
+    << "mechanization:              "
+    << (mechanization == MechanizationOptions::Method::kRotationExact ? "rotation-exact"
+                                                                       : "classic two-sample")
+    << "\n"
+    << "earth rotation:             " << (earth_rotation ? "compensated" : "ignored") << "\n"
+    << "covariance time update:     "
+    << (covariance_interval > 0 ? "every " + std::to_string(covariance_interval) + " s"
+                                : std::string("every epoch"))
+    << "\n"
+    << faults.describe()
+    << "output interval:            "
+    << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
+    << "\n";
+  return o.str();
+}
+
+void NavigatorOptions::validate() const {
+  auto fail = [](const std::string& what, double v) {
+    throw InputError(what + ", got " + std::to_string(v));
+  };
+  if (!(covariance_interval >= 0.0 && covariance_interval <= kMaxCovarianceInterval))
+    fail("covariance interval: must be in [0, " + std::to_string(kMaxCovarianceInterval) + "] s",
+         covariance_interval);
+  if (!(output_interval >= 0.0) || !std::isfinite(output_interval))
+    fail("output interval: must be >= 0 s (0 = every epoch)", output_interval);
+  if (!(wheel.velocity_update_interval > 0.0) || !std::isfinite(wheel.velocity_update_interval))
+    fail("velocity update interval: must be > 0 s", wheel.velocity_update_interval);
+  if (!(fusion.position_update_interval > 0.0) || !std::isfinite(fusion.position_update_interval))
+    fail("position update interval: must be > 0 s", fusion.position_update_interval);
+  if (!(fusion.position_std > 0.0) || !std::isfinite(fusion.position_std))
+    fail("position constraint sigma: must be > 0 m", fusion.position_std);
+}
+
+}  // namespace wheelins

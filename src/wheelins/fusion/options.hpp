@@ -1,0 +1,84 @@
+// The navigator's settings (every filter and fusion option, in SI units), their
+// human-readable listing and their checks, and the counters a run reports.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "wheelins/filter/body_ins.hpp"
+#include "wheelins/filter/wheel_ins.hpp"
+#include "wheelins/fusion/fault_monitor.hpp"
+
+namespace wheelins {
+
+/// The most IMUs one navigator fuses.
+constexpr int kMaxModules = 16;
+
+/// How the Wheel-INSs get their forward speed.
+enum class SpeedSharing {
+  kMean,  ///< the paper: the mean of all Wheel-IMU speeds, for every subsystem
+  kOwn,   ///< each Wheel-INS its own wheel's speed; a Body-INS the mean, at the mean wheel point
+};
+
+struct FusionOptions {
+  SpeedSharing speed = SpeedSharing::kMean;
+  bool share_level = true;                ///< Body-INS roll/pitch to the Wheel-INSs
+  bool position_constraint = true;
+  double position_update_interval = 1.0;  ///< [s]; the paper's 1 Hz
+  double position_std = 0.2;              ///< [m] (Table 9)
+  double position_gate = 0.0;             ///< test-ratio gate; 0 = off
+  std::vector<double> weights;            ///< k_i of eq. (8); empty = equal
+  /// One joint covariance over all IMUs (Section VI-B-2) instead of one per subsystem.
+  bool centralized = false;
+};
+
+struct NavigatorOptions {
+  WheelInsOptions wheel;
+  BodyInsOptions body;
+  FusionOptions fusion;
+  MechanizationOptions::Method mechanization = MechanizationOptions::Method::kRotationExact;
+  /// Compensate the earth rotation (the manifest says whether the data contain it).
+  bool earth_rotation = true;
+  /// Sensor-fault handling: outages, saturation, slip, isolation of faulty IMUs.
+  FaultOptions faults;
+  /// Output interval [s]; 0 = every epoch of the first module.
+  double output_interval = 0.0;
+  /// Also send each subsystem's own solution to the sink (streams 1..N) of a multi-IMU run.
+  bool module_records = true;
+  /// Covariance time update every this many seconds, F integrated over the epochs in
+  /// between (StrapdownEkf::set_covariance_interval); 0 = every IMU epoch. Measurement
+  /// updates always see P propagated to their epoch. At most kMaxCovarianceInterval.
+  double covariance_interval = 0.05;
+  static constexpr double kMaxCovarianceInterval = 0.5;  ///< [s]
+  /// The options in human units (OpenVINS style), one per line.
+  std::string describe() const;
+  /// Throws InputError naming the option if a value is out of range (the fault options
+  /// are checked by FaultOptions::validate()).
+  void validate() const;
+};
+
+/// Counters and timing of a run.
+struct NavigatorStats {
+  std::uint64_t samples = 0;            ///< samples given to process()
+  std::uint64_t epochs = 0;             ///< navigation epochs of the first module
+  std::uint64_t velocity_updates = 0;   ///< per subsystem, summed
+  std::uint64_t velocity_rejected = 0;  ///< refused by the innovation gate
+  std::uint64_t position_updates = 0;
+  std::uint64_t position_rejected = 0;
+  std::uint64_t records = 0;
+  double t_start = 0.0, t_end = 0.0;    ///< navigation interval [s]
+  double max_velocity_test_ratio = 0.0;
+  double max_position_test_ratio = 0.0;
+  /// Time spent in the velocity-update and position-constraint steps (all subsystems) and
+  /// their number of occurrences, for the paper's Table 8 [s].
+  double velocity_step_seconds = 0.0, position_step_seconds = 0.0;
+  std::uint64_t velocity_steps = 0, position_steps = 0;
+  /// Covariance health, checked at every velocity-update step for every subsystem in use:
+  /// checks, failures of the Cholesky test (not positive definite), and the largest
+  /// asymmetry max|P - P^T| / max|P| seen.
+  std::uint64_t covariance_checks = 0, covariance_not_pd = 0;
+  double max_covariance_asymmetry = 0.0;
+};
+
+}  // namespace wheelins
