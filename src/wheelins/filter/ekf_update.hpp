@@ -26,15 +26,17 @@ struct UpdateReport {
   bool accepted = false;
 };
 
-/// Fuses one measurement of dimension M into (P, dx). With gate > 0, rejects it
-/// (P and dx untouched) when test_ratio > gate. Joseph form keeps P positive.
-template <int M>
-UpdateReport ekf_update(Mat21& P, Vec21& dx, const Eigen::Matrix<double, M, kStateDim>& H,
-                        const Eigen::Matrix<double, M, 1>& dz,
+/// Fuses one measurement of dimension M into (P, dx) of an N-dimensional error state: a
+/// subsystem's 21 states, or the stacked states of all IMUs (the centralized filter). With
+/// gate > 0, rejects it (P and dx untouched) when test_ratio > gate. Joseph form keeps P
+/// positive.
+template <int M, int N>
+UpdateReport ekf_update(Eigen::Matrix<double, N, N>& P, Eigen::Matrix<double, N, 1>& dx,
+                        const Eigen::Matrix<double, M, N>& H, const Eigen::Matrix<double, M, 1>& dz,
                         const Eigen::Matrix<double, M, M>& R, double gate = 0.0) {
   static_assert(M >= 1 && M <= 6);
   using MatM = Eigen::Matrix<double, M, M>;
-  using MatNM = Eigen::Matrix<double, kStateDim, M>;
+  using MatNM = Eigen::Matrix<double, N, M>;
   // Coefficient-based (lazy) products: at these fixed sizes they beat Eigen's blocked GEMM,
   // which packs its operands first.
   const MatNM PHt = P.lazyProduct(H.transpose());

@@ -11,7 +11,6 @@ template <int N>
 class FixedJointCovariance final : public JointCovariance {
   static constexpr int D = kStateDim * N;
   using MatD = Eigen::Matrix<double, D, D>;
-  using MatD3 = Eigen::Matrix<double, D, 3>;
   using H3D = Eigen::Matrix<double, 3, D>;
 
  public:
@@ -52,27 +51,11 @@ class FixedJointCovariance final : public JointCovariance {
     H3D Hb = H3D::Zero();
     for (int j = 0; j < N; ++j)
       if (H[j]) Hb.template middleCols<kStateDim>(kStateDim * j) = *H[j];
-    const MatD3 PHt = P_ * Hb.transpose();
-    const Mat3 S = Hb * PHt + R;
-    const Eigen::LLT<Mat3> llt(S);
-    UpdateReport rep;
-    rep.dim = 3;
-    for (int k = 0; k < 3; ++k) {
-      rep.innovation[k] = dz(k);
-      rep.innovation_var[k] = S(k, k);
-    }
-    for (int j = 0; j < N; ++j) dx[j].setZero();
-    if (llt.info() != Eigen::Success) return rep;
-    rep.nis = dz.dot(llt.solve(dz));
-    rep.test_ratio = rep.nis / kChi2_999[3];
-    if (gate > 0.0 && rep.test_ratio > gate) return rep;
-    const MatD3 K = llt.solve(PHt.transpose()).transpose();
-    const Eigen::Matrix<double, D, 1> dxb = K * dz;
-    // P <- P - K S K^T  (= (I - K H) P for the optimal gain), kept symmetric.
-    P_.noalias() -= K * PHt.transpose();
-    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    // The one EKF update (filter/ekf_update.hpp) over the stacked error state; the error
+    // estimate starts at zero (every subsystem is fed back after each update).
+    Eigen::Matrix<double, D, 1> dxb = Eigen::Matrix<double, D, 1>::Zero();
+    const UpdateReport rep = ekf_update<3, D>(P_, dxb, Hb, dz, R, gate);
     for (int j = 0; j < N; ++j) dx[j] = dxb.template segment<kStateDim>(kStateDim * j);
-    rep.accepted = true;
     return rep;
   }
 
