@@ -14,15 +14,15 @@ namespace wheelins {
 Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& modules,
                      const NavigatorOptions& options, Sink sink)
     : opt_(options),
-      sink_(std::move(sink)),
       frame_(setup.origin),
       source_(setup.source),
       static_start_(setup.static_start),
       static_end_(setup.static_end),
       initial_heading_(setup.initial_heading),
-      subs_(setup, modules, options) {
+      subs_(setup, modules, options),
+      filter_(make_filter_backend(subs_, options.fusion.centralized)),
+      output_(subs_, *filter_, frame_, opt_, std::move(sink)) {
   opt_.validate();
-  filter_ = make_filter_backend(subs_, opt_.fusion.centralized);
   static_.resize(subs_.size());
   std::vector<std::string> names;
   for (int i = 0; i < subs_.size(); ++i) names.push_back(subs_[i].module().name);
@@ -112,7 +112,7 @@ void Navigator::process(int index, const ImuSample& raw) {
   // (raw.t > last: when the driving module changes, the new one may share the epoch.)
   if (raw.t + 1e-9 >= next_output_t_ && raw.t > last_output_t_) {
     last_output_t_ = raw.t;
-    write_records(raw.t);
+    output_.write(raw.t, vehicle_modules(), in_use_mask());
     ++stats_.records;
     if (opt_.output_interval > 0)
       while (next_output_t_ <= raw.t + 1e-9) next_output_t_ += opt_.output_interval;
@@ -327,47 +327,6 @@ void Navigator::position_update() {
   }
 }
 
-TrajectoryRecord Navigator::subsystem_record(int i, bool with_lla) const {
-  const Subsystem& s = subs_[i];
-  const StrapdownEkf& ekf = s.ekf();
-  Mat21 scratch;
-  const Mat21& P = filter_->covariance(i, scratch);
-  TrajectoryRecord r;
-  r.t = ekf.state().t;
-  const ReferencePointModel m = reference_point_model(s.reference_point_input());
-  r.p_inN = m.r_o;
-  if (with_lla) r.lla = frame_.geodetic_from_ned(r.p_inN);
-  else r.lla.lat = r.lla.lon = r.lla.h = std::numeric_limits<double>::quiet_NaN();
-  r.v_inN = s.reference_velocity_inW();
-  const Eigen::RowVector3d J = s.heading_sensitivity();
-  const double var_psi = J * P.block<3, 3>(PHI, PHI) * J.transpose();
-  if (!s.is_wheel()) {
-    r.rpy = subs_.body().vehicle_rpy();
-    r.rpy_std.head<2>() = P.block<2, 2>(PHI, PHI).diagonal().cwiseSqrt();
-  } else {
-    r.rpy = Vec3(0.0, 0.0, s.vehicle_heading());
-    if (subs_.has_body() && opt_.fusion.share_level)
-      r.rpy.head<2>() = subs_.body().vehicle_rpy().head<2>();
-  }
-  r.rpy_std.z() = std::sqrt(std::max(0.0, var_psi));
-  // diag(H P H^T) over the columns eq. (8) depends on: H = [I 0 A 0 ...] over (dr, dv, phi),
-  // so only the top-left 9 x 9 of P enters (the tail of H is zero, checked in debug builds).
-  assert(m.H.rightCols<kStateDim - 9>().isZero());
-  const Eigen::Matrix<double, 3, 9> Hs = m.H.leftCols<9>();
-  r.p_std = Hs.lazyProduct(P.topLeftCorner<9, 9>()).cwiseProduct(Hs).rowwise().sum().cwiseSqrt();
-  r.v_std = P.block<3, 3>(V, V).diagonal().cwiseSqrt();
-  const ImuErrors& e = ekf.errors();
-  r.bg = e.bg;
-  r.ba = e.ba;
-  r.sg = e.sg;
-  r.sa = e.sa;
-  r.bg_std = P.block<3, 3>(BG, BG).diagonal().cwiseSqrt();
-  r.ba_std = P.block<3, 3>(BA, BA).diagonal().cwiseSqrt();
-  r.sg_std = P.block<3, 3>(SG, SG).diagonal().cwiseSqrt();
-  r.sa_std = P.block<3, 3>(SA, SA).diagonal().cwiseSqrt();
-  return r;
-}
-
 std::array<bool, Navigator::kMaxModules> Navigator::vehicle_modules() const {
   std::array<bool, kMaxModules> use{};
   bool any = false;
@@ -377,90 +336,7 @@ std::array<bool, Navigator::kMaxModules> Navigator::vehicle_modules() const {
   return use;
 }
 
-int Navigator::first_used(const std::array<bool, kMaxModules>& use) {
-  for (int i = 0; i < kMaxModules; ++i)
-    if (use[i]) return i;
-  return 0;
-}
-
-TrajectoryRecord Navigator::vehicle_record() const { return fused_record(vehicle_modules()); }
-
-void Navigator::write_records(double t) {
-  const std::array<bool, kMaxModules> use = vehicle_modules();
-  const int first = first_used(use);
-  const int n = subsystem_count();
-  // Geodetic coordinates only where a record leaves (fuse_records makes the fused one's).
-  const bool modules_out = n > 1 && opt_.module_records;
-  for (int i = 0; i < n; ++i)
-    if (use[i] || i == first || (modules_out && in_use(i)))
-      out_recs_[i] = subsystem_record(i, n == 1);
-  TrajectoryRecord v = fuse_records(use, out_recs_);
-  v.t = t;  // the epoch of the module driving the output
-  sink_(0, v);
-  if (modules_out)
-    for (int i = 0; i < n; ++i)
-      // A module whose data have stopped (not yet declared out) has nothing new.
-      if (in_use(i) && subs_[i].time() > rt_[i].last_record_t) {
-        rt_[i].last_record_t = subs_[i].time();
-        out_recs_[i].lla = frame_.geodetic_from_ned(out_recs_[i].p_inN);
-        sink_(i + 1, out_recs_[i]);
-      }
-}
-
-TrajectoryRecord Navigator::fused_record(const std::array<bool, kMaxModules>& use) const {
-  Records recs;
-  const int first = first_used(use);
-  for (int i = 0; i < subsystem_count(); ++i)
-    if (use[i] || i == first) recs[i] = subsystem_record(i);
-  return fuse_records(use, recs);
-}
-
-TrajectoryRecord Navigator::fuse_records(const std::array<bool, kMaxModules>& use,
-                                         const Records& recs) const {
-  int n_use = 0;
-  double ksum = 0.0;
-  for (int i = 0; i < subsystem_count(); ++i)
-    if (use[i]) {
-      ++n_use;
-      ksum += subs_.weight(i);
-    }
-  TrajectoryRecord r = recs[first_used(use)];
-  if (subs_.size() == 1 || n_use <= 1) {
-    if (!std::isfinite(r.lla.lat)) r.lla = frame_.geodetic_from_ned(r.p_inN);
-    return r;
-  }
-  // Output as in the paper: the fused reference point and the mean heading. The 1-sigma
-  // of a weighted mean is bounded by the weighted mean of the sigmas whatever the
-  // correlation between subsystems (Minkowski), which is what is reported.
-  Vec3 p = Vec3::Zero(), v = Vec3::Zero(), p_std = Vec3::Zero(), v_std = Vec3::Zero();
-  double s = 0.0, c = 0.0, psi_std = 0.0;
-  int body_index = -1;
-  for (int i = 0; i < subsystem_count(); ++i) {
-    if (!use[i]) continue;
-    if (i == subs_.body_index()) body_index = i;
-    const TrajectoryRecord& ri = recs[i];
-    const double k = subs_.weight(i) / ksum;
-    p += k * ri.p_inN;
-    v += k * ri.v_inN;
-    p_std += k * ri.p_std;
-    v_std += k * ri.v_std;
-    s += k * std::sin(ri.rpy.z());
-    c += k * std::cos(ri.rpy.z());
-    psi_std += k * ri.rpy_std.z();
-  }
-  r.p_inN = p;
-  r.lla = frame_.geodetic_from_ned(p);
-  r.v_inN = v;
-  r.p_std = p_std;
-  r.v_std = v_std;
-  r.rpy.z() = std::atan2(s, c);
-  r.rpy_std.z() = psi_std;
-  if (body_index >= 0) {
-    const Vec3 rpy = subs_.body().vehicle_rpy();
-    r.rpy.head<2>() = rpy.head<2>();
-  }
-  return r;
-}
+TrajectoryRecord Navigator::vehicle_record() const { return output_.fused(vehicle_modules()); }
 
 // ------------------------------------------------------------------ fault handling
 
@@ -666,7 +542,7 @@ VehicleFix Navigator::vehicle_fix(int i, double t) const {
   VehicleFix fix;
   fix.t = t;
   if (any) {
-    const TrajectoryRecord r = fused_record(use);
+    const TrajectoryRecord r = output_.fused(use);
     fix.p_OinW = r.p_inN + r.v_inN * (t - r.t);
     fix.v_OinW = r.v_inN;
     fix.heading = r.rpy.z();
@@ -676,7 +552,7 @@ VehicleFix Navigator::vehicle_fix(int i, double t) const {
   }
   // Alone: its own solution before the gap, extrapolated at constant velocity; the
   // uncertainty grows with the distance driven blind.
-  const TrajectoryRecord r = subsystem_record(i);
+  const TrajectoryRecord r = output_.record(i);
   const double blind = (t - r.t) * r.v_inN.norm();
   fix.p_OinW = r.p_inN + r.v_inN * (t - r.t);
   fix.v_OinW = r.v_inN;

@@ -21,6 +21,7 @@
 #include "wheelins/fusion/filter_backend.hpp"
 #include "wheelins/fusion/measurement.hpp"
 #include "wheelins/fusion/options.hpp"
+#include "wheelins/fusion/output.hpp"
 #include "wheelins/fusion/subsystems.hpp"
 #include "wheelins/nav/trajectory_record.hpp"
 #include "wheelins/nav/vehicle.hpp"
@@ -32,7 +33,7 @@ class Navigator {
   static constexpr int kMaxModules = wheelins::kMaxModules;
   /// Receives records: stream 0 is the vehicle (the fused solution), streams 1..N the
   /// subsystems' own solutions (only when N > 1).
-  using Sink = std::function<void(int stream, const TrajectoryRecord&)>;
+  using Sink = OutputFusion::Sink;
 
   /// `modules`: names of modules of `setup`; the first one drives the output epochs.
   /// Throws InputError if a name is unknown or the set has no Wheel-IMU. (A Manifest
@@ -86,27 +87,13 @@ class Navigator {
   bool reference_weights(std::array<double, kMaxModules>& k, int& n_ref, int& n_tied) const;
   void position_update();
   Mat21 covariance(int i) const;
-  /// Subsystem i's own solution; without lat/lon/h (left NaN) when with_lla is false.
-  TrajectoryRecord subsystem_record(int i, bool with_lla = true) const;
-  /// Weighted mean of the subsystems in `use` (the paper's output, eq. 9).
-  TrajectoryRecord fused_record(const std::array<bool, kMaxModules>& use) const;
-  using Records = std::array<TrajectoryRecord, kMaxModules>;
-  /// The same from records already made (recs[i] valid where use[i], and recs[first]).
-  TrajectoryRecord fuse_records(const std::array<bool, kMaxModules>& use,
-                                const Records& recs) const;
   /// Which modules the vehicle solution is made of now.
   std::array<bool, kMaxModules> vehicle_modules() const;
-  /// The first module in `use` (0 if none).
-  static int first_used(const std::array<bool, kMaxModules>& use);
-  /// Output of one epoch: the vehicle record and each module's, each made once.
-  void write_records(double t);
-  Records out_recs_{};  ///< scratch of write_records (no allocation per epoch)
   double min_time() const;
 
   // Fault handling (fault_monitor.hpp).
   struct Runtime {
     double last_t = 0.0;             ///< newest sample seen
-    double last_record_t = -1e300;   ///< time of the last subsystem record written
     MotionAccumulator realign;       ///< while kRealign
     double saturated_until = -1e300; ///< the gyro was at full scale until this time + hold
     bool saturation_reported = false;
@@ -137,12 +124,12 @@ class Navigator {
   void fault_housekeeping(double t);
 
   NavigatorOptions opt_;
-  Sink sink_;
   earth::LocalFrame frame_;
   std::string source_;  ///< where the setup came from (messages)
   double static_start_, static_end_, initial_heading_;
   Subsystems subs_;
   std::unique_ptr<FilterBackend> filter_;
+  OutputFusion output_;
   std::vector<StaticAccumulator> static_;
   SharedInputs shared_;    ///< scratch of the update steps (no allocation per epoch)
   Measurement meas_;       ///< scratch of the update steps
