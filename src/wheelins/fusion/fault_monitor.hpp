@@ -3,7 +3,7 @@
 // the health of every module, the innovation-based fault detector, the
 // counters, and the fault report (what was detected, when, what was done).
 //
-// The navigator decides and acts (it owns the filters); this class only keeps
+// The fault handler (fault_handler.hpp) decides and acts; this class only keeps
 // the state machine and the record, so it can be tested on its own.
 //
 //   kOk ──(no data for stale_after)──> kOut ──(data again)──> kRealign

@@ -1,23 +1,29 @@
-// The navigator: turns a time-ordered stream of IMU samples from the modules of
-// a manifest into a vehicle trajectory. Data flow (one way):
+// The navigator: turns a time-ordered stream of IMU samples of the selected modules
+// into a vehicle trajectory, the paper's algorithm (Sections III and V) end to end.
+// Data flow (one way):
 //   samples -> static alignment -> subsystems (Wheel-INS, Body-INS) -> fusion -> records.
 // Phases: samples before the static period are skipped, samples inside it are
 // accumulated for the initial alignment, navigation starts at its end.
 //
-// Fusion (paper Section III and V-B, the distributed filter): every subsystem keeps
-// its own 21-state EKF. At the velocity-update rate the wheel speed is shared (the
-// mean over the Wheel-INSs, or each wheel's own speed), the Body-INS's roll/pitch is
-// given to the Wheel-INSs, and every subsystem fuses its velocity + NHC. At the
-// position-constraint rate, the weighted mean of the subsystems' reference points
-// (eq. 9) is a position measurement for each of them (eq. 12).
+// Every sample is mechanized by its subsystem. At the velocity-update rate the
+// subsystems share the Body-INS roll/pitch and the wheel speed (the mean over the
+// Wheel-INSs, or each wheel's own) and every subsystem fuses its velocity + NHC
+// (eq. 5, 6); at the position-constraint rate the weighted mean of the subsystems'
+// reference points (eq. 7, 8) is a position measurement for each of them (eq. 11).
+// The navigator holds the parts and calls them in that order (process()):
+//   Subsystems     the Wheel-INSs and the Body-INS            (subsystems.hpp)
+//   measurements   built once for both filter structures      (measurement.hpp)
+//   FilterBackend  distributed (the paper) or centralized     (filter_backend.hpp)
+//   OutputFusion   the vehicle solution and the records       (output.hpp)
+//   FaultHandler   sensor faults, behind a few hooks          (fault_handler.hpp)
 #pragma once
 
-#include <functional>
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "wheelins/fusion/fault_monitor.hpp"
+#include "wheelins/fusion/fault_handler.hpp"
 #include "wheelins/fusion/filter_backend.hpp"
 #include "wheelins/fusion/measurement.hpp"
 #include "wheelins/fusion/options.hpp"
@@ -36,11 +42,13 @@ class Navigator {
   using Sink = OutputFusion::Sink;
 
   /// `modules`: names of modules of `setup`; the first one drives the output epochs.
-  /// Throws InputError if a name is unknown or the set has no Wheel-IMU. (A Manifest
-  /// converts to its VehicleSetup: Navigator(manifest, modules, options, sink).)
+  /// Throws InputError if a name is unknown, the set has no Wheel-IMU or an option is out of
+  /// range. (A Manifest converts to its VehicleSetup: Navigator(manifest, modules, ...).)
   Navigator(const VehicleSetup& setup, const std::vector<std::string>& modules,
             const NavigatorOptions& options, Sink sink);
   ~Navigator();
+  Navigator(const Navigator&) = delete;
+  Navigator& operator=(const Navigator&) = delete;
 
   /// One raw sample (sensor axes, increments) of module `index` (position in `modules`).
   /// Samples must come in time order across modules.
@@ -62,22 +70,25 @@ class Navigator {
   /// The fused vehicle solution now.
   TrajectoryRecord vehicle_record() const;
   /// Health, counters and the report of detected faults.
-  const FaultMonitor& faults() const { return faults_; }
+  const FaultMonitor& faults() const { return faults_->monitor(); }
   /// Closes the fault statistics at the end of the data.
   void finish();
 
  private:
+  using Use = std::array<bool, kMaxModules>;
   void start_navigation(double t0);
-  /// Velocity updates of every module in use (the measurements of measurement.hpp, fused by
-  /// the filter back-end). Like position_update(), it expects every covariance at the
-  /// current epoch (process() flushes them first).
-  void velocity_updates();
-  void count_velocity_update(int i, const UpdateReport& rep, double t_now);
+  /// The velocity + NHC updates of every module in use, and the position constraint of
+  /// every module tied to the others. Both expect every covariance at the current epoch
+  /// (process() flushes them first).
+  void velocity_step();
+  void position_step();
   /// The Body-INS level is shared: sharing on and the Body-INS counted.
   bool level_shared() const;
   /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
   void share_level();
-  std::array<bool, kMaxModules> in_use_mask() const;
+  /// The wheel speeds of this velocity step: the paper's mean over the wheels, less what
+  /// the fault handling screens out.
+  void select_speeds(double t);
   /// The shared quantities of the velocity step (speeds_ selection) and of the position step
   /// (sh.k weights), at the current state; `level_now`: see SharedInputs::level_now.
   void take_speeds(SharedInputs& sh, bool level_now) const;
@@ -85,43 +96,16 @@ class Navigator {
   /// The reference weights k (eq. 8) renormalised over the counted modules (0 for the
   /// others); false when no module counts.
   bool reference_weights(std::array<double, kMaxModules>& k, int& n_ref, int& n_tied) const;
-  void position_update();
-  Mat21 covariance(int i) const;
-  /// Which modules the vehicle solution is made of now.
-  std::array<bool, kMaxModules> vehicle_modules() const;
-  double min_time() const;
-
-  // Fault handling (fault_monitor.hpp).
-  struct Runtime {
-    double last_t = 0.0;             ///< newest sample seen
-    MotionAccumulator realign;       ///< while kRealign
-    double saturated_until = -1e300; ///< the gyro was at full scale until this time + hold
-    bool saturation_reported = false;
-    bool speed_rejected = false;     ///< in a streak of rejected wheel speeds
-    bool detector_fired = false;     ///< reported once for a lone module
-    int heading_fails = 0;           ///< consecutive constraint epochs off the others' heading
-    ImuErrors errors_new, errors_old;  ///< sensor-error estimates 0-10 s and 10-20 s ago
-    double snapshot_t = -1e300;
-    bool have_snapshot = false;
-    bool revert_errors = false;      ///< restart from errors_old (after an isolation)
-  };
-  static constexpr double kSnapshotInterval = 10.0;  ///< [s]
-  static constexpr double kSaturationFree = 1.0;     ///< [s] unsaturated before lending its speed
-  void isolate(int i, double t, const std::string& what);
-  void check_headings(double t);
+  void count_velocity_update(int i, const UpdateReport& rep, double t);
+  /// Covariance health of every subsystem in use (Cholesky test, asymmetry).
   void check_covariances();
-  void check_wheel_speeds(double t, const std::array<WheelVelocityInput, kMaxModules>& own,
-                          std::array<bool, kMaxModules>& speed_ok);
-  bool in_use(int i) const { return !opt_.faults.enabled || faults_.flowing(i); }
-  bool counted(int i) const { return !opt_.faults.enabled || faults_.counts(i); }
+  /// Time of the subsystem in use that is furthest behind.
+  double min_time() const;
+  /// The first module in use: it drives the output epochs (-1 if none).
   int output_driver() const;
-  void watch_outages(int index, double t);
-  void handle_saturation(int index, const ImuSample& raw, ImuSample& b);
-  bool substitute_speed(int wheel_index, double* speed) const;
-  void begin_realign(int i, double t, const std::string& what, const std::string& action);
-  void restart(int i, double t);
-  VehicleFix vehicle_fix(int i, double t) const;
-  void fault_housekeeping(double t);
+  Use in_use_mask() const;
+  /// Which modules the vehicle solution is made of now.
+  Use vehicle_modules() const;
 
   NavigatorOptions opt_;
   earth::LocalFrame frame_;
@@ -130,14 +114,11 @@ class Navigator {
   Subsystems subs_;
   std::unique_ptr<FilterBackend> filter_;
   OutputFusion output_;
+  std::unique_ptr<FaultHandler> faults_;
   std::vector<StaticAccumulator> static_;
   SharedInputs shared_;    ///< scratch of the update steps (no allocation per epoch)
   Measurement meas_;       ///< scratch of the update steps
   SpeedSelection speeds_;  ///< the wheel speeds usable at the last update epoch
-  FaultMonitor faults_;
-  bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
-  std::array<bool, kMaxModules> excused_{};  ///< saturated or recovering this epoch
-  std::vector<Runtime> rt_;
   bool navigating_ = false;
   double last_output_t_ = -1e300;
   double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;

@@ -1,0 +1,135 @@
+// Sensor-fault handling as its own part of the fusion (docs/faults.md), behind a few
+// hooks the navigator calls at fixed points of the paper's algorithm
+// (Navigator::process()):
+//   on_start            navigation starts
+//   on_sample           every sample after the alignment: outages and gaps, re-levelling
+//                       and the restart of a module that comes back, gyro saturation (the
+//                       sample may be edited, or held back from navigation)
+//   on_velocity_step    before a velocity-update step: snapshots of the sensor errors,
+//                       probation passed, retries of isolated modules
+//   screen_speeds       which wheel speeds the step may use (saturation, slip or lift)
+//   on_velocity_update  each velocity update's report: the innovation-based detector
+//   on_position_step    before a position-constraint step: the heading check (3+ modules)
+//   finish              the end of the data
+// and three queries the algorithm reads: in_use (navigating on its own data), counted
+// (in the fused solution, the mean speed and the constraint's reference) and tied
+// (receives the position constraint).
+//
+// NoFaultHandling, when fault handling is off, keeps every module in use and counted and
+// acts on nothing. FaultPolicy decides and acts: it restarts a module from the others
+// (through the subsystems, the filter back-end and the output fusion it is given).
+// FaultMonitor (fault_monitor.hpp) keeps the health state machine and the report.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "wheelins/fusion/fault_monitor.hpp"
+#include "wheelins/fusion/output.hpp"
+
+namespace wheelins {
+
+class FaultHandler {
+ public:
+  virtual ~FaultHandler() = default;
+  FaultHandler(const FaultHandler&) = delete;
+  FaultHandler& operator=(const FaultHandler&) = delete;
+
+  bool in_use(int i) const { return monitor_.flowing(i); }
+  bool counted(int i) const { return monitor_.counts(i); }
+  bool tied(int i) const { return monitor_.tied(i); }
+  /// Health, counters and the report of detected faults.
+  const FaultMonitor& monitor() const { return monitor_; }
+
+  /// Navigation starts at t0 (every subsystem aligned).
+  virtual void on_start(double /*t0*/) {}
+  /// Sample `raw` of module i, `b` the same in its b-frame (may be edited). False: the
+  /// sample is not navigated.
+  virtual bool on_sample(int /*i*/, const ImuSample& /*raw*/, ImuSample& /*b*/) { return true; }
+  /// A velocity-update step begins at time t.
+  virtual void on_velocity_step(double /*t*/) {}
+  /// The wheel speeds of the step at time t: `sel.speed_ok` holds the wheels in use; the
+  /// handler clears the unusable ones and marks those usable only as a lower bound
+  /// (`sel.fallback`). `wheel`: each wheel's velocity input with its own speed.
+  virtual void screen_speeds(double /*t*/,
+                             const std::array<WheelVelocityInput, kMaxModules>& /*wheel*/,
+                             SpeedSelection& /*sel*/) {}
+  /// Module i's velocity update at time t was fused (or refused: rep.accepted false).
+  virtual void on_velocity_update(int i, const UpdateReport& rep, double /*t*/) {
+    if (!rep.accepted) ++monitor_.stats(i).velocity_rejected;
+  }
+  /// A position-constraint step begins at time t.
+  virtual void on_position_step(double /*t*/) {}
+  /// The data end at time t.
+  virtual void finish(double t) { monitor_.finish(t); }
+
+ protected:
+  explicit FaultHandler(FaultMonitor monitor) : monitor_(std::move(monitor)) {}
+  FaultMonitor monitor_;
+};
+
+/// Fault handling off: every sample and module is used as it comes.
+class NoFaultHandling final : public FaultHandler {
+ public:
+  NoFaultHandling(std::vector<std::string> module_names, const FaultOptions& options)
+      : FaultHandler(FaultMonitor(std::move(module_names), options)) {}
+};
+
+/// The fault policy of docs/faults.md.
+class FaultPolicy final : public FaultHandler {
+ public:
+  /// `subs`, `filter` and `output` are the navigator's; they must outlive the policy.
+  FaultPolicy(const FaultOptions& options, Subsystems& subs, FilterBackend& filter,
+              const OutputFusion& output);
+
+  void on_start(double t0) override;
+  bool on_sample(int i, const ImuSample& raw, ImuSample& b) override;
+  void on_velocity_step(double t) override;
+  void screen_speeds(double t, const std::array<WheelVelocityInput, kMaxModules>& wheel,
+                     SpeedSelection& sel) override;
+  void on_velocity_update(int i, const UpdateReport& rep, double t) override;
+  void on_position_step(double t) override;
+
+  static constexpr double kSnapshotInterval = 10.0;  ///< [s]
+  static constexpr double kSaturationFree = 1.0;     ///< [s] unsaturated before lending its speed
+
+ private:
+  struct Runtime {
+    double last_t = 0.0;             ///< newest sample seen
+    MotionAccumulator realign;       ///< while kRealign
+    double saturated_until = -1e300; ///< the gyro was at full scale until this time + hold
+    bool saturation_reported = false;
+    bool speed_rejected = false;     ///< in a streak of rejected wheel speeds
+    bool detector_fired = false;     ///< reported once for a lone module
+    int heading_fails = 0;           ///< consecutive constraint epochs off the others' heading
+    ImuErrors errors_new, errors_old;  ///< sensor-error estimates 0-10 s and 10-20 s ago
+    double snapshot_t = -1e300;
+    bool have_snapshot = false;
+    bool revert_errors = false;      ///< restart from errors_old (after an isolation)
+  };
+  void watch_outages(int index, double t);
+  void handle_saturation(int index, const ImuSample& raw, ImuSample& b);
+  bool substitute_speed(int wheel_index, double* speed) const;
+  void check_wheel_speeds(double t, const std::array<WheelVelocityInput, kMaxModules>& own,
+                          std::array<bool, kMaxModules>& speed_ok);
+  void isolate(int i, double t, const std::string& what);
+  void begin_realign(int i, double t, const std::string& what, const std::string& action);
+  /// Where module i restarts at time t: the others' fused solution (or its own, alone).
+  VehicleFix vehicle_fix(int i, double t) const;
+  void restart(int i, double t);
+
+  FaultOptions opt_;
+  Subsystems& subs_;
+  FilterBackend& filter_;
+  const OutputFusion& output_;
+  std::vector<Runtime> rt_;
+  bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
+  std::array<bool, kMaxModules> excused_{};  ///< saturated or recovering this step
+};
+
+/// FaultPolicy when options.enabled, else NoFaultHandling.
+std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, Subsystems& subs,
+                                                 FilterBackend& filter, const OutputFusion& output);
+
+}  // namespace wheelins
