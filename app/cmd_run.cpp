@@ -60,7 +60,8 @@ void check_range(const std::optional<double>& v, const char* option, double lo, 
 int run(const RunArgs& a) {
   check_range(a.duration, "--duration", 0.0, 1e7, "s", true);
   check_range(a.output_interval, "--output-interval", 0.0, 5.0, "s (0 = every epoch)");
-  check_range(a.covariance_interval, "--covariance-interval", 0.0, 0.5, "s (0 = every epoch)");
+  check_range(a.covariance_interval, "--covariance-interval", 0.0,
+              NavigatorOptions::kMaxCovarianceInterval, "s (0 = every epoch)");
   if (!a.modules.empty() && !a.configuration.empty())
     throw InputError("--modules and --configuration both given: --modules names the IMUs "
                      "itself; give one of them");

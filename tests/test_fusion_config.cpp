@@ -142,3 +142,25 @@ TEST(FusionNavigator, NeedsAWheelImuAndKnownModules) {
   EXPECT_NE(err({"left-C1", "body-C1", "body-C4"}).find("only one Body-IMU"), std::string::npos);
   EXPECT_NE(err({}).find("no module selected"), std::string::npos);
 }
+
+TEST(FusionNavigator, RefusesOptionsOutOfRange) {
+  // The navigator checks its options itself (NavigatorOptions::validate()), whoever made
+  // them: an interval of 0 would never advance its schedule.
+  Manifest m = three_groups();
+  const auto err = [&](const NavigatorOptions& o) {
+    return error_of([&] { Navigator(m, {"left-C1"}, o, [](int, const TrajectoryRecord&) {}); });
+  };
+  NavigatorOptions o;
+  o.covariance_interval = 0.6;
+  EXPECT_NE(err(o).find("covariance interval: must be in [0, 0.5"), std::string::npos) << err(o);
+  o = NavigatorOptions{};
+  o.wheel.velocity_update_interval = 0.0;
+  EXPECT_NE(err(o).find("velocity update interval: must be > 0 s"), std::string::npos) << err(o);
+  o = NavigatorOptions{};
+  o.fusion.position_update_interval = -1.0;
+  EXPECT_NE(err(o).find("position update interval"), std::string::npos) << err(o);
+  o = NavigatorOptions{};
+  o.output_interval = -0.1;
+  EXPECT_NE(err(o).find("output interval"), std::string::npos) << err(o);
+  EXPECT_NO_THROW(Navigator(m, {"left-C1"}, NavigatorOptions{}, [](int, const TrajectoryRecord&) {}));
+}

@@ -1,6 +1,7 @@
 #include "wheelins/fusion/options.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace wheelins {
@@ -41,12 +42,14 @@ std::string NavigatorOptions::describe() const {
 }
 
 void NavigatorOptions::validate() const {
-  auto fail = [](const std::string& what, double v) {
-    throw InputError(what + ", got " + std::to_string(v));
+  auto fail = [](const char* what, double v) {
+    char got[48];
+    std::snprintf(got, sizeof got, ", got %.17g", v);
+    throw InputError(what + std::string(got));
   };
+  static_assert(kMaxCovarianceInterval == 0.5, "quoted below");
   if (!(covariance_interval >= 0.0 && covariance_interval <= kMaxCovarianceInterval))
-    fail("covariance interval: must be in [0, " + std::to_string(kMaxCovarianceInterval) + "] s",
-         covariance_interval);
+    fail("covariance interval: must be in [0, 0.5] s", covariance_interval);
   if (!(output_interval >= 0.0) || !std::isfinite(output_interval))
     fail("output interval: must be >= 0 s (0 = every epoch)", output_interval);
   if (!(wheel.velocity_update_interval > 0.0) || !std::isfinite(wheel.velocity_update_interval))

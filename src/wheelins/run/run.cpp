@@ -255,8 +255,7 @@ void validate_run_request(const RunRequest& r) {
   if (!(n.output_interval >= 0.0 && n.output_interval <= 5.0))
     throw InputError("output interval: must be in [0, 5] s (0 = every epoch; the evaluation "
                      "interpolates across at most 5 s), got " + format_double(n.output_interval));
-  if (!(n.covariance_interval >= 0.0 && n.covariance_interval <= 0.5))
-    throw InputError("covariance interval: must be in [0, 0.5] s, got " + format_double(n.covariance_interval));
+  n.validate();  // the navigator's own ranges (the covariance interval, the update intervals)
   if (n.fusion.centralized && r.modules.size() < 2)
     throw InputError("the centralized filter joins several IMUs; a run of one module ('" +
                      r.modules.front() + "') has nothing to join (drop --centralized / "

@@ -80,8 +80,10 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
       c.earth_rotation = y.choice<std::string>(v, "filter.earth_rotation",
                                                {{"auto", "auto"}, {"true", "true"}, {"false", "false"}});
     if (auto v = y.get(f, "covariance_interval_s"); v.IsDefined()) {
-      c.nav.covariance_interval = y.number_in(v, "filter.covariance_interval_s", 0.0, 0.5,
-                                              "s (0 = every epoch)");
+      // NavigatorOptions' range, checked here to name the key and its line.
+      c.nav.covariance_interval =
+          y.number_in(v, "filter.covariance_interval_s", 0.0,
+                      NavigatorOptions::kMaxCovarianceInterval, "s (0 = every epoch)");
     }
     if (auto v = y.get(f, "velocity_update_hz"); v.IsDefined()) {
       const double hz = y.number_in(v, "filter.velocity_update_hz", 0.05, 100.0, "Hz");
