@@ -1,6 +1,6 @@
-// The multi-IMU simulator: exact IMU data for two Wheel-IMUs and a Body-IMU
-// (four chips each) from a Scenario, with a seeded, switchable error model, and
-// the dataset writer behind `wheelins simulate`.
+// The multi-IMU simulator's facade: exact IMU data for two Wheel-IMUs and a
+// Body-IMU (four chips each) from a Scenario, with a seeded, switchable error
+// model, and the dataset writer behind `wheelins simulate`.
 //
 // Physics (docs/simulator.md): every IMU point's position and attitude are
 // analytic functions of time (sim/jet.hpp); each sample is the mean angular
@@ -8,6 +8,14 @@
 //   gyro  = omega_nb^s + C_n^s omega_ie^n,
 //   accel = C_n^s (a^n - g^n + 2 omega_ie^n x v^n),
 // consistent with nav/mechanization.cpp (v' = C f - 2 omega_ie x v + g).
+//
+// The parts: sim/kinematics (wheel rolling and slip, vibration gain, the group
+// stepper), sim/vibration, sim/chip_errors (the per-sample error model and sensor
+// faults), sim/draws (every random parameter), and, as members of Simulation,
+// simulator.cpp (building the scenario and the draws), truth_queries.cpp (the true
+// motion, error-free samples) and dataset_writer.cpp (the files, the manifests and
+// errors.yaml, one writer thread per module). sim/imu_stream.hpp streams the
+// samples of a Simulation in memory (no files).
 #pragma once
 
 #include <array>
@@ -18,77 +26,12 @@
 
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/nav/types.hpp"
+#include "wheelins/sim/chip_errors.hpp"
 #include "wheelins/sim/config.hpp"
-#include "wheelins/sim/rng.hpp"
+#include "wheelins/sim/kinematics.hpp"
 #include "wheelins/sim/scenario.hpp"
 
 namespace wheelins::sim {
-
-/// Band-limited vibration of a module: displacement (v-frame) and small rotation
-/// (ZYX Euler angles, v-frame), each a sum of sinusoids with random frequencies in a
-/// band, so its derivatives (the accelerations and rates it causes) are exact.
-struct Vibration {
-  struct Component {
-    double amplitude = 0.0, omega = 0.0, phase = 0.0;
-  };
-  std::array<std::vector<Component>, 6> dof;  ///< x, y, z [m], roll, pitch, yaw [rad]
-  std::array<std::vector<std::array<double, 8>>, 6> node_phasors;  ///< cos, sin of omega*offset_i
-  std::array<std::vector<std::array<double, 4>>, 6> phase_state;   ///< sin, cos now; cos, sin of omega h
-  double step_h = 0.0, last_mid = 0.0;
-  int since_exact = -1;
-  bool empty() const { return dof[0].empty(); }
-  void eval(double t, JV& disp, JV& rot) const;
-  /// The same at t_mid + offsets[i], i = 0..3, for offsets fixed by prepare() (one sine and
-  /// cosine per component instead of four: the angle-sum identities do the rest).
-  /// Consecutive calls h apart advance each component's phase by a rotation (recomputed
-  /// exactly every 256 calls; the recurrence adds < 1e-13 relative error).
-  void prepare(const double offsets[4], double h);
-  void eval4(double t_mid, JV disp[4], JV rot[4]);
-  static Vibration draw(Rng& rng, const Vec3& accel_rms, const Vec3& rate_rms, const double band[2],
-                        int components = 24);
-};
-
-/// One physical module as simulated (the truth) and as the manifest states it.
-struct ModuleModel {
-  /// A wheel-slip fault event (sim/faults.hpp) in true (scenario) time: the rolling rate is
-  /// multiplied by 1 + ratio * w(t), w = slip_window over [t0, t1] (t1 = +inf: open-ended).
-  struct SlipEvent {
-    double t0 = 0.0, t1 = 0.0, ratio = 0.0;
-  };
-  ModuleGeometry truth;        ///< geometry used to simulate
-  ModuleGeometry manifest;     ///< geometry written to manifest.yaml (calibration residuals)
-  double radius = 0.0;         ///< true effective rolling radius (wheel) [m]
-  double radius_manifest = 0.0;
-  double slip_coeff = 0.0;     ///< [s^2/m], 0 without the slip effect
-  std::vector<SlipEvent> slip_events;  ///< slip faults of this wheel
-  double time_offset = 0.0;    ///< true clock offset: a sample stamped t covers (t-dt+off, t+off]
-  double temp_rise = 0.0;      ///< [K]
-  Vibration vibration;
-  /// The vibration scales with the speed v of o: gain = s(v) / s(v_cruise), s(v) = x / (1 + x),
-  /// x = (v / (0.3 v_cruise))^2: zero at rest, 1 at the cruise speed (a smooth function of the
-  /// motion, so the vibrating displacement still has exact derivatives).
-  double vib_cruise_speed = 1.4;
-};
-
-/// Error parameters drawn for one chip (SI units).
-struct ChipModel {
-  std::string name;  ///< e.g. "left-C1"
-  Vec3 gyro_bias = Vec3::Zero(), accel_bias = Vec3::Zero();  ///< turn-on
-  Vec3 gyro_gm0 = Vec3::Zero(), accel_gm0 = Vec3::Zero();    ///< initial Gauss-Markov state
-  Mat3 gyro_T = Mat3::Identity(), accel_T = Mat3::Identity();  ///< I + scale factor + misalignment
-  Vec3 gyro_tempco = Vec3::Zero(), accel_tempco = Vec3::Zero();  ///< per K
-};
-
-/// The true motion of one IMU (sensor axes) at an instant.
-struct ImuTruth {
-  Vec3 p_inN, v_inN, a_inN;
-  Mat3 C_StoN;
-  Vec3 omega_nb_inS;   ///< angular rate w.r.t. the n-frame
-  Vec3 gyro_inS;       ///< + earth rate: what an ideal gyro reads
-  Vec3 accel_inS;      ///< specific force (what an ideal accelerometer reads)
-  double wheel_angle = 0.0, wheel_rate = 0.0;  ///< alpha, d alpha/dt (wheel modules)
-  double wheel_centre_speed = 0.0;  ///< forward speed of the wheel centre (rigid motion) [m/s]
-};
 
 struct DatasetSummary {
   double duration = 0.0;   ///< [s]
@@ -149,8 +92,12 @@ class Simulation {
   static const char* group_name(int g);
   static const char* group_dir(int g);
 
+  /// The sample grid and the environment of the group steppers.
+  StepperClock clock() const;
+  /// A stepper of module g on its clock offset by `offset` [s].
+  GroupStepper stepper(int g, double offset) const;
+
  private:
-  friend class GroupStepper;
   std::string errors_yaml() const;
 
   SimConfig cfg_;
