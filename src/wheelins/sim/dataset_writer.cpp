@@ -18,6 +18,7 @@
 #include "wheelins/io/truth.hpp"
 #include "wheelins/nav/types.hpp"
 #include "wheelins/sim/faults.hpp"
+#include "wheelins/sim/sampler.hpp"
 #include "wheelins/sim/text.hpp"
 #include "wheelins/util/interrupt.hpp"
 #include "wheelins/util/progress.hpp"
@@ -243,9 +244,9 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
 
   const double t0 = start_time();
   const double rate = cfg_.rate_hz;
-  const std::uint64_t K = static_cast<std::uint64_t>(std::floor((end_ - t0) * rate + 1e-6));
+  const std::uint64_t K = sample_count();
   if (K < 2) throw InputError("simulate: the duration is shorter than two samples");
-  auto stamp = [&](std::uint64_t k) { return t0 + static_cast<double>(k) / rate; };
+  auto stamp = [&](std::uint64_t k) { return this->stamp(k); };
   const std::uint64_t per_second = static_cast<std::uint64_t>(std::llround(rate));
 
   std::atomic<std::uint64_t> done{0};
@@ -254,8 +255,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
   auto worker = [&](int g) {
     try {
       const ModuleModel& m = modules_[g];
-      const bool wheel_noise = m.truth.wheel && cfg_.on("wheel_noise");
-      GroupStepper st = stepper(g, m.time_offset);
+      ModuleSampler sampler(*this, g);
       std::unique_ptr<GroupStepper> ideal;
       if (m.time_offset != 0.0) ideal = std::make_unique<GroupStepper>(*scenario_, m, clock(), 0.0);
       std::unique_ptr<BinaryRowWriter> ideal_out;
@@ -263,50 +263,30 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
         ideal_out = std::make_unique<BinaryRowWriter>(
             dir / "ideal" / (std::string(group_name(g)) + "_imu.bin"), 7);
       std::vector<std::unique_ptr<BinaryRowWriter>> outs, bias_outs;
-      std::vector<std::unique_ptr<ChipErrors>> errs;
-      std::vector<ChipFaults> faults;
+      std::vector<ChipSampler> chips;
       for (const ChipModel& c : chips_[g]) {
-        faults.emplace_back(cfg_.faults, group_name(g), c.name);
+        chips.emplace_back(*this, g, c);
         const std::string chip = c.name.substr(c.name.find('-') + 1);
         outs.push_back(std::make_unique<BinaryRowWriter>(dir / group_dir(g) / ("tri_" + chip + "_imu.bin"), 7));
         bias_outs.push_back(std::make_unique<BinaryRowWriter>(dir / "errors" / (c.name + "_bias.bin"), 7));
-        errs.push_back(std::make_unique<ChipErrors>(cfg_, c));
       }
       double row[7];
       for (std::uint64_t k = 1; k <= K; ++k) {
-        const double b = stamp(k);
-        Vec3 w, f, wi, fi;
-        st.step(b, w, f);
-        if (ideal) ideal->step(b, wi, fi);
-        else wi = w, fi = f;
+        sampler.step(k);
+        const double b = sampler.t();
+        Vec3 wi = sampler.gyro(), fi = sampler.accel();
+        if (ideal) ideal->step(b, wi, fi);  // the error-free stream has no clock offset
         row[0] = b;
         for (int i = 0; i < 3; ++i) row[1 + i] = wi[i], row[4 + i] = fi[i];
         if (ideal_out) ideal_out->write(row);
-        const double dT = m.temp_rise * (1.0 - std::exp(-(b + m.time_offset - t0) / cfg_.errors.temp_tau));
-        // Sample k is at tau = k / rate since the start of the data (fault times).
-        const double tau = static_cast<double>(k) / rate;
-        // Wheel white noise from rolling: its density follows the vibration gain of the speed.
-        double wheel_sigma = 0.0;
-        if (wheel_noise) {
-          const double v = scenario_->state(b + m.time_offset - 0.5 / rate).v_inN.norm();
-          const double rest = cfg_.errors.wheel_accel_noise_rest;
-          wheel_sigma = cfg_.errors.wheel_accel_noise * std::sqrt(rate) *
-                        (rest + (1.0 - rest) * vibration_gain(m, v));
-        }
-        for (std::size_t c = 0; c < errs.size(); ++c) {
-          Vec3 wm, fm, step_g, step_a;
-          // The error model runs on every sample (a dropout or a stuck axis draws the same
-          // random numbers), so the data after a sensor fault equal the fault-free run's.
-          if (faults[c].steps(tau, step_g, step_a))
-            errs[c]->apply(dT, w, f, wm, fm, wheel_sigma, &step_g, &step_a);
-          else
-            errs[c]->apply(dT, w, f, wm, fm, wheel_sigma);
-          faults[c].hold(tau, wm, fm);
+        for (std::size_t c = 0; c < chips.size(); ++c) {
+          Vec3 wm, fm;
+          const bool kept = chips[c].read(sampler, wm, fm);
           for (int i = 0; i < 3; ++i) row[1 + i] = wm[i], row[4 + i] = fm[i];
-          if (!faults[c].dropped(tau)) outs[c]->write(row);
+          if (kept) outs[c]->write(row);
           if (k % per_second == 0) {
-            const Vec3& bg = errs[c]->gyro_bias();
-            const Vec3& ba = errs[c]->accel_bias();
+            const Vec3& bg = chips[c].errors().gyro_bias();
+            const Vec3& ba = chips[c].errors().accel_bias();
             for (int i = 0; i < 3; ++i) row[1 + i] = bg[i], row[4 + i] = ba[i];
             bias_outs[c]->write(row);
           }

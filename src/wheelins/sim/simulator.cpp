@@ -108,6 +108,10 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
   }
 }
 
+std::uint64_t Simulation::sample_count() const {
+  return static_cast<std::uint64_t>(std::floor((end_ - start_time()) * cfg_.rate_hz + 1e-6));
+}
+
 double Simulation::data_duration() const {
   // The writer's sample count K: the last sample is stamped start + K / rate.
   const double K = std::floor((end_ - start_time()) * cfg_.rate_hz + 1e-6);

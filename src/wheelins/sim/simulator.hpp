@@ -58,6 +58,9 @@ class Simulation {
   /// The length of the data [s]: the last IMU sample is stamped start_time() + data_duration()
   /// (fault times count from start_time(); sample k is at k / rate).
   double data_duration() const;
+  /// The number K of samples per module file, and the stamp of sample k = 1..K [s].
+  std::uint64_t sample_count() const;
+  double stamp(std::uint64_t k) const { return start_time() + static_cast<double>(k) / cfg_.rate_hz; }
   double speed_scale() const { return speed_scale_; }
   const ModuleModel& module(int g) const { return modules_[g]; }
   const std::vector<ChipModel>& chips(int g) const { return chips_[g]; }
