@@ -111,7 +111,7 @@ Mat21 spd_covariance() {
 }
 
 void BM_PositionConstraintUpdate(benchmark::State& state) {
-  // One subsystem's update of eq. (12): the reference point model (eq. 8) and the fusion.
+  // One subsystem's update of eq. (11): the reference point model (eq. 7) and the fusion.
   ReferencePointInput in;
   in.wheel = true;
   in.C_BtoW = dcm_from_euler(Vec3(0.3, 0.01, 1.2));

@@ -230,7 +230,7 @@ TEST_F(NavEndToEnd, CentralizedMeasurementJacobiansMatchFiniteDifference) {
   // The centralized filter's H (Section VI-B-2) against a finite difference of the
   // navigator's own measurement over every IMU's error state: the mean wheel speed depends
   // on every Wheel-IMU's gyro-x bias and scale factor, a Wheel-INS model on the Body-INS
-  // level, and the position constraint (eq. 12) on everything eq. (8) uses. A feedback of
+  // level, and the position constraint (eq. 11) on everything eq. (7) uses. A feedback of
   // +eps e_k removes an error eps e_k, so the column is -(dz(+) - dz(-)) / (2 eps).
   const Manifest m = load_manifest(*field_ / "manifest.yaml", {});
   const auto modules = configuration_modules(m, "triple", {});

@@ -1,3 +1,5 @@
+// The accuracy figures of metrics.hpp: the streaming Evaluator (truth interpolation,
+// drift rate over distance segments, heading RMSE, NEES) and evaluate() on whole files.
 #include "wheelins/eval/metrics.hpp"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// Static alignment (alignment.hpp): roll and pitch from the mean specific force, and the
+// attitude that gives the vehicle a stated heading.
 #include "wheelins/filter/alignment.hpp"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+// The Body-INS subsystem (body_ins.hpp): alignment and restart, its reference point o
+// (eq. 7 through C_b^v), the velocity of o, and the eq. (6) model at a rear-axle point.
 #include "wheelins/filter/body_ins.hpp"
 
 #include "wheelins/filter/wheel_velocity.hpp"

@@ -1,3 +1,4 @@
+// The Body-INS velocity + NHC model of body_velocity.hpp: z_hat and H of eq. (6).
 #include "wheelins/filter/body_velocity.hpp"
 
 namespace wheelins {

@@ -1,3 +1,5 @@
+// The error-state dynamics of eq. (2) (error_model.hpp): F and its blocks, the discrete
+// process noise, and the covariance time update, dense and block-sparse.
 #include "wheelins/filter/error_model.hpp"
 
 namespace wheelins {

@@ -1,3 +1,5 @@
+// The reference point model of position_constraint.hpp: r_o of eq. (7) for a Wheel-IMU
+// (through the wheel centre) or a Body-IMU, and its H_mlt (eq. 11, Appendix B).
 #include "wheelins/filter/position_constraint.hpp"
 
 #include "wheelins/filter/wheel_velocity.hpp"
@@ -18,7 +20,7 @@ ReferencePointModel reference_point_model(const ReferencePointInput& in) {
     const Eigen::RowVector3d dpsi_dphi = wheel_heading_sensitivity(C);
     const Vec3 dRa_dpsi = Rz * skew(Vec3::UnitZ()) * a;
     m.H.block<3, 3>(0, PHI) = skew(Cl) - dRa_dpsi * dpsi_dphi;
-    // Eq. (8) with C_v^w = Rz Ry(theta) Rx(phi): d(Ry Rx)/d phi = Ry Rx [e_x x], d/d theta = Ry [e_y x] Rx.
+    // Eq. (7) with C_v^w = Rz Ry(theta) Rx(phi): d(Ry Rx)/d phi = Ry Rx [e_x x], d/d theta = Ry [e_y x] Rx.
     const Mat3 Rx = rot_x(in.vehicle_roll), Ry = rot_y(in.vehicle_pitch);
     m.H_level.col(0) = -Rz * Ry * Rx * skew(Vec3::UnitX()) * in.p_inV;
     m.H_level.col(1) = -Rz * Ry * skew(Vec3::UnitY()) * Rx * in.p_inV;

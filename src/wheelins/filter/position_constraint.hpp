@@ -1,12 +1,13 @@
-// Multi-IMU position constraint (paper Section V-B, Algorithm 1, eq. 8-13).
+// Multi-IMU position constraint (paper Section V-B, Algorithm 1, eq. 7-11 and H_mlt of
+// Appendix B).
 //
 // Each subsystem i computes the reference point o (mid rear axle) from its own
-// state, eq. (8):  r_o = r_b - C_v^w r_b^v. For a Wheel-IMU the fixed point in the
+// state, eq. (7) (oinwframe):  r_o = r_b - C_v^w r_b^v. For a Wheel-IMU the fixed point in the
 // v-frame is the wheel centre, reached through the lever arm:
 //   r_o = r_b + C_b^w l^b - C_v^w r_wc^v,  C_v^w = Rz(psi_v) Ry(theta) Rx(phi)
 // with psi_v from the Wheel-IMU heading; for a Body-IMU C_v^w = C_b^w C_v^b.
-// The weighted mean of all subsystems' o, eq. (9), is the measurement for every
-// subsystem (dz = r_o_hat - r_o_fused, eq. 12), noise 0.2 m (Table 9).
+// The weighted mean of all subsystems' o, eq. (8) (weightedpos), is the measurement for every
+// subsystem (dz = r_o_hat - r_o_fused, eq. 11, mltIMUmeasurement), noise 0.2 m (Table 9).
 #pragma once
 
 #include "wheelins/filter/error_state.hpp"
@@ -25,7 +26,7 @@ struct ReferencePointInput {
 };
 
 struct ReferencePointModel {
-  Vec3 r_o = Vec3::Zero();  ///< o in the w-frame, eq. (8)
+  Vec3 r_o = Vec3::Zero();  ///< o in the w-frame, eq. (7)
   Eigen::Matrix<double, 3, kStateDim> H = Eigen::Matrix<double, 3, kStateDim>::Zero();  ///< H_mlt
   /// Wheel-IMU: d r_o / d [vehicle roll, pitch] (the level shared by a Body-INS); zero for a
   /// Body-IMU, whose C_v^w is its own attitude.

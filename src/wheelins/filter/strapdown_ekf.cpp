@@ -1,3 +1,5 @@
+// The strapdown EKF of strapdown_ekf.hpp: initialisation, the nominal propagation with
+// the accumulation of F over the covariance interval, the time update, and the feedback.
 #include "wheelins/filter/strapdown_ekf.hpp"
 
 namespace wheelins {

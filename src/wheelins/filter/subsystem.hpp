@@ -81,7 +81,7 @@ class Subsystem {
   virtual double vehicle_heading() const = 0;
   /// d(heading)/d(phi), for the heading's 1-sigma.
   virtual Eigen::RowVector3d heading_sensitivity() const = 0;
-  /// Inputs of eq. (8) for this subsystem: where it puts the reference point o.
+  /// Inputs of eq. (7) for this subsystem: where it puts the reference point o.
   virtual ReferencePointInput reference_point_input() const = 0;
   /// Vehicle velocity at o in the w-frame.
   virtual Vec3 reference_velocity_inW() const = 0;

@@ -1,3 +1,5 @@
+// The Wheel-INS subsystem (wheel_ins.hpp): alignment and restart of a spinning Wheel-IMU,
+// the wheel speed from its gyro-x window (eq. 3), its velocity input (eq. 5) and its o.
 #include "wheelins/filter/wheel_ins.hpp"
 
 #include <algorithm>
@@ -46,7 +48,7 @@ void WheelIns::begin(const NavState& s, const ImuErrors& e, const InitialUncerta
 
 void WheelIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
   // As start(), in motion: the wheel angle and axle tilt from the averaged specific force,
-  // the axle direction from the vehicle heading, the IMU placed from o by eq. (8).
+  // the axle direction from the vehicle heading, the IMU placed from o by eq. (7).
   Vec3 rpy = level_from_specific_force(mean_f_inB);
   rpy.z() = wrap_pi(fix.heading + axle_sign_ * 0.5 * kPi);
   NavState s;

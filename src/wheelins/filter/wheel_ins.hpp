@@ -71,7 +71,7 @@ class WheelIns final : public Subsystem {
   Mat3 C_VtoW() const;
   /// Wheel-centre position in the w-frame.
   Vec3 wheel_centre_inW() const;
-  /// Eq. (8) through the wheel centre: r_o = r_b + C_b^w l^b - C_v^w r_wc^v.
+  /// Eq. (7) through the wheel centre: r_o = r_b + C_b^w l^b - C_v^w r_wc^v.
   ReferencePointInput reference_point_input() const override;
   /// Velocity of o from the wheel-centre velocity and the vehicle yaw rate.
   Vec3 reference_velocity_inW() const override;

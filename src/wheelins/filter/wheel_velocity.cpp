@@ -1,3 +1,5 @@
+// The Wheel-IMU velocity + NHC model of wheel_velocity.hpp: z_hat and H_v of eq. (5)
+// (Appendix B), the vehicle heading of a Wheel-IMU and its sensitivities.
 #include "wheelins/filter/wheel_velocity.hpp"
 
 #include <cmath>

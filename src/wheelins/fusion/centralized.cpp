@@ -1,3 +1,5 @@
+// The centralized filter of centralized.hpp: the fixed-size joint covariance for 2..5
+// IMUs (block time update, the update through ekf_update) and its back-end.
 #include "wheelins/fusion/centralized.hpp"
 
 #include <string>

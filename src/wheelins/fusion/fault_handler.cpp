@@ -1,3 +1,5 @@
+// The fault policy of fault_handler.hpp (docs/faults.md): outages and gaps, re-levelling
+// and restarts, saturation, slip, the innovation detector, the heading check.
 #include "wheelins/fusion/fault_handler.hpp"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+// The fault bookkeeping of fault_monitor.hpp: options and their checks, the health
+// state machine, the detector window, and the fault report (CSV and text).
 #include "wheelins/fusion/fault_monitor.hpp"
 
 #include <cmath>

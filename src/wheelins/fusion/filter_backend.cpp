@@ -1,3 +1,5 @@
+// The distributed back-end of filter_backend.hpp (one EKF per subsystem), and the factory
+// that picks it or the centralized one.
 #include "wheelins/fusion/filter_backend.hpp"
 
 #include "wheelins/fusion/centralized.hpp"

@@ -1,3 +1,5 @@
+// The measurement builders of measurement.hpp: the shared inputs taken at one evaluation
+// point, and the velocity (eq. 5, 6) and position-constraint (eq. 11) measurements.
 #include "wheelins/fusion/measurement.hpp"
 
 namespace wheelins {

@@ -1,3 +1,5 @@
+// The navigator of navigator.hpp: alignment, the per-sample flow of process(), the
+// velocity and position-constraint steps, and the bookkeeping (stats, covariance health).
 #include "wheelins/fusion/navigator.hpp"
 
 #include <algorithm>

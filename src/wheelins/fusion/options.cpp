@@ -1,3 +1,4 @@
+// NavigatorOptions::describe() (the option listing of `wheelins run`) and validate().
 #include "wheelins/fusion/options.hpp"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+// The output fusion of output.hpp: a subsystem's record for o with its 1-sigma figures,
+// the weighted vehicle solution (eq. 8, mean heading), and one epoch's records.
 #include "wheelins/fusion/output.hpp"
 
 #include <algorithm>
@@ -51,7 +53,7 @@ TrajectoryRecord OutputFusion::record(int i, bool with_lla) const {
       r.rpy.head<2>() = subs_.body().vehicle_rpy().head<2>();
   }
   r.rpy_std.z() = std::sqrt(std::max(0.0, var_psi));
-  // diag(H P H^T) over the columns eq. (8) depends on: H = [I 0 A 0 ...] over (dr, dv, phi),
+  // diag(H P H^T) over the columns eq. (7) depends on: H = [I 0 A 0 ...] over (dr, dv, phi),
   // so only the top-left 9 x 9 of P enters (the tail of H is zero, checked in debug builds).
   assert(m.H.rightCols<kStateDim - 9>().isZero());
   const Eigen::Matrix<double, 3, 9> Hs = m.H.leftCols<9>();

@@ -1,3 +1,5 @@
+// Building the navigator's subsystems from a VehicleSetup (subsystems.hpp), with the
+// checks of the selection and the normalised weights.
 #include "wheelins/fusion/subsystems.hpp"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+// Atomic output files (atomic_file.hpp): the temporary name, commit and the refusal to
+// overwrite; the fast fixed-notation number writer.
 #include "wheelins/io/atomic_file.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// Block-buffered readers and writers of little-endian float64 rows (binary.hpp).
 #include "wheelins/io/binary.hpp"
 
 #include <bit>

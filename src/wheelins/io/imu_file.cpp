@@ -1,3 +1,5 @@
+// IMU file reading and writing (imu_file.hpp): the validating streaming reader with its gap
+// report, the writer, and the time-ordered merger of several streams.
 #include "wheelins/io/imu_file.hpp"
 
 #include <cmath>

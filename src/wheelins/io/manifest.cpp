@@ -1,3 +1,5 @@
+// Loading, checking and saving manifests (manifest.hpp): human units <-> SI with exact
+// round trips, every key checked with the file and line named; Manifest -> VehicleSetup.
 #include "wheelins/io/manifest.hpp"
 
 #include <yaml-cpp/yaml.h>

@@ -1,3 +1,5 @@
+// The manifest draft of manifest_draft.hpp: finding the layout's files, reading their rate,
+// static period and initial pose, and listing what the user must still measure.
 #include "wheelins/io/manifest_draft.hpp"
 
 #include <algorithm>

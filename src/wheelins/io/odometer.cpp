@@ -1,3 +1,4 @@
+// Odometer file reading and writing (odometer.hpp).
 #include "wheelins/io/odometer.hpp"
 
 #include <cmath>

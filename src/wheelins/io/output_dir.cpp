@@ -1,3 +1,5 @@
+// The all-or-nothing output directory of output_dir.hpp: staging, locking, and the move
+// into place.
 #include "wheelins/io/output_dir.hpp"
 
 #include <fcntl.h>

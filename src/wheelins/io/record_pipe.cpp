@@ -1,3 +1,4 @@
+// The record hand-over between threads of record_pipe.hpp.
 #include "wheelins/io/record_pipe.hpp"
 
 namespace wheelins {

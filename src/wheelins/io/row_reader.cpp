@@ -1,3 +1,4 @@
+// The row readers of row_reader.hpp (binary and text) with the location of every value.
 #include "wheelins/io/row_reader.hpp"
 
 #include <charconv>

@@ -1,3 +1,4 @@
+// Exact number formatting and strict parsing (text_util.hpp), and the text helpers of io.
 #include "wheelins/io/text_util.hpp"
 
 #include <sys/stat.h>

@@ -1,3 +1,5 @@
+// Trajectory files (trajectory.hpp): the CSV, TUM and KML writers and the validating
+// reader of CSV, TUM and the public Wheel-INS traj.txt.
 #include "wheelins/io/trajectory.hpp"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// Truth files (truth.hpp): the layout detection (11- or 5-column rows, checked against
+// the content), the streaming reader, read_truth() and the writers.
 #include "wheelins/io/truth.hpp"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// The YAML reader of yaml_reader.hpp: typed values with ranges, key checks with the
+// closest known key, and errors naming the file, key path and line.
 #include "wheelins/io/yaml_reader.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// Rotation conversions of rotation.hpp: Euler angles, rotation vectors, quaternions.
 #include "wheelins/math/rotation.hpp"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// The earth model of earth.hpp: normal gravity, earth rate, and geodetic <-> local NED.
 #include "wheelins/nav/earth.hpp"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+// Strapdown mechanization (mechanization.hpp; docs/filter.md section 2): the
+// rotation-exact and the classic two-sample attitude, velocity and position updates.
 #include "wheelins/nav/mechanization.hpp"
 
 namespace wheelins {

@@ -11,7 +11,7 @@
 //    which is exact when the angular rate is constant over the interval and the
 //    specific force is constant in the navigation frame. A Wheel-IMU turning at
 //    15 rad/s sees gravity rotate by 0.075 rad per 200 Hz sample; this form
-//    stays exact there (docs/mechanization.md, section 2).
+//    stays exact there (docs/filter.md, section 2).
 //
 //  kClassicTwoSample: the textbook rotation + sculling correction
 //        dv^{b(k-1)} = dv_k + dtheta_k x dv_k / 2 + (dtheta_{k-1} x dv_k + dv_{k-1} x dtheta_k) / 12,

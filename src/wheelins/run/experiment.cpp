@@ -1,3 +1,5 @@
+// The paper's experiment (experiment.hpp): its run plan, the runs in parallel through
+// run_navigation() with a streaming evaluation, and Tables 4-8 as Markdown, CSV and JSON.
 #include "wheelins/run/experiment.hpp"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// The experiment's plots (plots.hpp): the data and gnuplot scripts of Fig. 7-10 and the
+// trajectory, and running gnuplot on them.
 #include "wheelins/run/plots.hpp"
 
 #include <fcntl.h>

@@ -1,3 +1,4 @@
+// The named IMU configurations of presets.hpp resolved against a manifest.
 #include "wheelins/run/presets.hpp"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// One navigation run (run.hpp): the request's checks, the files read through the input
+// checks and merged, the navigator, the writers on a second thread, the staged outputs.
 #include "wheelins/run/run.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// Loading a run configuration (run_config.hpp) and turning it into a RunRequest.
 #include "wheelins/run/run_config.hpp"
 
 #include <cmath>

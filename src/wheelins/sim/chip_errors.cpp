@@ -1,3 +1,5 @@
+// The chip error model of chip_errors.hpp: the per-sample error processes and the
+// sensor-fault events on a chip's output.
 #include "wheelins/sim/chip_errors.hpp"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// Simulator settings (config.hpp): presets, profiles and effects, their checks, and the
+// scenario.yaml form both ways.
 #include "wheelins/sim/config.hpp"
 
 #include <yaml-cpp/yaml.h>

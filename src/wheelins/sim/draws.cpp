@@ -1,3 +1,5 @@
+// Every random draw of a dataset (draws.hpp): the modules' physical parameters and the
+// chips' error parameters, each from its own named stream.
 #include "wheelins/sim/draws.hpp"
 
 namespace wheelins::sim {

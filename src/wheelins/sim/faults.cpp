@@ -1,3 +1,4 @@
+// Sensor-fault events (faults.hpp): the --fault spec and YAML forms, parsed and written.
 #include "wheelins/sim/faults.hpp"
 
 #include "wheelins/io/text_util.hpp"

@@ -1,3 +1,4 @@
+// The Gaussian-smoothed polyline of gauss_polyline.hpp.
 #include "wheelins/sim/gauss_polyline.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// The in-memory IMU stream of imu_stream.hpp.
 #include "wheelins/sim/imu_stream.hpp"
 
 namespace wheelins::sim {

@@ -1,3 +1,5 @@
+// The kinematics of kinematics.hpp: rolling rate and slip, vibration gain, and the group
+// stepper's quadrature of the exact rates over each sample.
 #include "wheelins/sim/kinematics.hpp"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// The module and chip samplers of sampler.hpp.
 #include "wheelins/sim/sampler.hpp"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+// The scenarios of scenario.hpp: the default loop, paths from KML/CSV with a speed
+// profile, terrain, skid, and the exact vehicle motion they give.
 #include "wheelins/sim/scenario.hpp"
 
 #include <algorithm>

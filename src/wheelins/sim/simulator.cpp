@@ -1,3 +1,5 @@
+// The facade of simulator.hpp: building the scenario, drawing every parameter, checking
+// the fault events, and the accessors (truth_queries.cpp and dataset_writer.cpp hold the rest).
 #include "wheelins/sim/simulator.hpp"
 
 #include <algorithm>

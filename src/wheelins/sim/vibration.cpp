@@ -1,3 +1,5 @@
+// The module vibration of vibration.hpp: drawing it, and evaluating it exactly at a time
+// or at a sample's four quadrature nodes.
 #include "wheelins/sim/vibration.hpp"
 
 #include <cmath>

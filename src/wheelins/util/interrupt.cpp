@@ -1,3 +1,4 @@
+// The interrupt flag of interrupt.hpp.
 #include "wheelins/util/interrupt.hpp"
 
 #include <atomic>

@@ -1,3 +1,4 @@
+// The terminal progress line of progress.hpp.
 #include "wheelins/util/progress.hpp"
 
 #include "wheelins/util/interrupt.hpp"
