@@ -67,6 +67,27 @@ TEST(FilterCovariance, MultipliedOutJosephEqualsTextbookForm) {
   EXPECT_EQ((P - P.transpose()).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(FilterCovariance, StackedStateUpdateEqualsTextbookJoseph) {
+  // The centralized filter's update over 3 x 21 stacked states (ekf_update<3, 63>, which
+  // updates the lower triangle and mirrors it) against the textbook Joseph form.
+  using Mat63 = Eigen::Matrix<double, 63, 63>;
+  Mat63 A = Mat63::Random();
+  const Mat63 P0 = A * A.transpose() * 1e-3 + Mat63::Identity() * 1e-4;
+  const Eigen::Matrix<double, 3, 63> H = Eigen::Matrix<double, 3, 63>::Random();
+  const Vec3 dz(0.03, -0.01, 0.02);
+  const Mat3 R = Vec3(0.02, 0.03, 0.01).cwiseAbs2().asDiagonal();
+  Mat63 P = P0;
+  Eigen::Matrix<double, 63, 1> dx = Eigen::Matrix<double, 63, 1>::Zero();
+  ASSERT_TRUE((ekf_update<3, 63>(P, dx, H, dz, R).accepted));
+  const Mat3 S = H * P0 * H.transpose() + R;
+  const Eigen::Matrix<double, 63, 3> K = P0 * H.transpose() * S.inverse();
+  const Mat63 IKH = Mat63::Identity() - K * H;
+  const Mat63 joseph = IKH * P0 * IKH.transpose() + K * R * K.transpose();
+  EXPECT_LT((P - joseph).cwiseAbs().maxCoeff(), 1e-12 * joseph.cwiseAbs().maxCoeff());
+  EXPECT_LT((dx - K * dz).norm(), 1e-12 * (K * dz).norm());
+  EXPECT_EQ((P - P.transpose()).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(FilterCovariance, LowerRateTimeUpdateFollowsThePerEpochOne) {
   // A Wheel-IMU spinning at 14 rad/s about its x-axis (the axle) while the vehicle turns
   // slowly: C_b^w turns by 0.7 rad within one 0.05 s covariance interval, which the
