@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <regex>
 
 #include "io_test_util.hpp"
 #include "wheelins/eval/metrics.hpp"
@@ -93,8 +92,21 @@ class Hardening : public ::testing::Test {
 };
 fs::path* Hardening::dir_ = nullptr;
 
-void replace(std::string& s, const std::string& pattern, const std::string& with) {
-  s = std::regex_replace(s, std::regex(pattern), with);
+/// Replaces `key` and the value after it (a number, a [...] list, or nothing: a literal key)
+/// at its first occurrence by `with`. (Not std::regex: GCC 12 warns falsely inside it under
+/// the sanitizers, and the CI builds those with -Werror.)
+void replace(std::string& s, const std::string& key, const std::string& with) {
+  const std::size_t at = s.find(key);
+  ASSERT_NE(at, std::string::npos) << "no '" << key << "' in the text";
+  std::size_t end = at + key.size();
+  if (end < s.size() && s[end] == '[') {
+    end = s.find(']', end);
+    ASSERT_NE(end, std::string::npos);
+    ++end;
+  } else {
+    while (end < s.size() && std::string("0123456789.eE+-").find(s[end]) != std::string::npos) ++end;
+  }
+  s.replace(at, end - at, with);
 }
 
 // ------------------------------------------------------------------ numbers and NaN entering
@@ -105,12 +117,12 @@ TEST_F(Hardening, ManifestNumbersOutsideTheirRangeAreErrors) {
     const char* with;
     const char* key;
   } cases[] = {
-      {"wheel_radius_m: [0-9.e-]+", "wheel_radius_m: 1e-9", "wheel_radius_m: must be in [0.01, 2]"},
-      {"gyro_bias_tau_h: [0-9.e-]+", "gyro_bias_tau_h: 1e-6", "gyro_bias_tau_h: must be in"},
-      {"gyro_arw_deg_sqrt_h: [0-9.e-]+", "gyro_arw_deg_sqrt_h: 1e300", "gyro_arw_deg_sqrt_h: must be in"},
-      {"gravity_m_s2: [0-9.e-]+", "gravity_m_s2: 4.9", "gravity_m_s2: must be in [9.7, 9.9]"},
-      {"rate_hz: [0-9.e-]+", "rate_hz: 1e9", "rate_hz: must be in"},
-      {"h_m: [0-9.e-]+", "h_m: 1e7", "initial.h_m: must be in"},
+      {"wheel_radius_m: ", "wheel_radius_m: 1e-9", "wheel_radius_m: must be in [0.01, 2]"},
+      {"gyro_bias_tau_h: ", "gyro_bias_tau_h: 1e-6", "gyro_bias_tau_h: must be in"},
+      {"gyro_arw_deg_sqrt_h: ", "gyro_arw_deg_sqrt_h: 1e300", "gyro_arw_deg_sqrt_h: must be in"},
+      {"gravity_m_s2: ", "gravity_m_s2: 4.9", "gravity_m_s2: must be in [9.7, 9.9]"},
+      {"rate_hz: ", "rate_hz: 1e9", "rate_hz: must be in"},
+      {"h_m: ", "h_m: 1e7", "initial.h_m: must be in"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.with);
@@ -216,7 +228,7 @@ TEST(HardeningSim, SettingsAreCheckedOnceAllAreIn) {
 TEST_F(Hardening, StaticPeriodFormatAndRateAreCheckedFromTheData) {
   {
     const fs::path d = variant("moving", [](std::string& t) {
-      replace(t, "static_period_s: \\[[^\\]]*\\]", "static_period_s: [100040, 100044]");
+      replace(t, "static_period_s: ", "static_period_s: [100040, 100044]");
     });
     EXPECT_HAS(error_of([&] { run_navigation(request(d, "single")); }), "deg/s on average in the static period");
   }
@@ -360,6 +372,7 @@ TEST_F(Hardening, RunKilledMidwayKeepsTheEarlierResults) {
 
 // --------------------------------------------------------------------------- bounded memory
 
+#ifndef WHEELINS_ASAN
 /// Runs `f` in a child process limited to `mb` of address space; true if it ended with an
 /// InputError (not a crash and not bad_alloc).
 bool input_error_within(std::size_t mb, const std::function<void()>& f) {
@@ -382,6 +395,7 @@ bool input_error_within(std::size_t mb, const std::function<void()>& f) {
   ::waitpid(pid, &status, 0);
   return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
+#endif
 
 TEST(HardeningMemory, HugeAndEndlessInputsStayWithinAFewHundredMegabytes) {
 #ifdef WHEELINS_ASAN
