@@ -38,6 +38,7 @@ struct RunArgs {
   bool centralized = false;
   bool no_constraint = false;
   bool no_faults = false;
+  bool fixed_noise = false;
   bool no_evaluate = false;
   bool force = false;
   bool quiet = false;
@@ -92,6 +93,7 @@ int run(const RunArgs& a) {
   if (a.force) cfg.overwrite = true;
   if (a.duration) cfg.max_duration = *a.duration;
   if (a.no_faults) cfg.nav.faults.enabled = false;
+  if (a.fixed_noise) cfg.nav.noise.enabled = false;
   if (a.output_interval) cfg.nav.output_interval = *a.output_interval;
   if (a.covariance_interval) cfg.nav.covariance_interval = *a.covariance_interval;
 
@@ -163,6 +165,7 @@ int run(const RunArgs& a) {
               static_cast<unsigned long long>(st.covariance_checks),
               static_cast<unsigned long long>(st.covariance_not_pd), st.max_covariance_asymmetry);
   if (req.nav.faults.enabled) std::cout << res.fault_report;
+  std::cout << res.noise_report;
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
 
   if (evaluate) {
@@ -222,6 +225,9 @@ const bool registered = cli::register_command(
       sub.add_flag("--no-evaluate", a->no_evaluate,
                    "Do not evaluate against the manifest's truth (the evaluation streams the truth "
                    "file alongside the run)");
+      sub.add_flag("--fixed-noise", a->fixed_noise,
+                   "Hold the manifest's noise figures (or the defaults) fixed instead of identifying "
+                   "them from the data (docs/filter.md section 13)");
       sub.add_flag("--no-fault-handling", a->no_faults,
                    "Use every sample and module as it comes (no outage, saturation, slip or "
                    "fault isolation)");

@@ -193,7 +193,11 @@ TEST(IoManifest, MinimalManifestUsesDefaultsAndConvertsUnits) {
   EXPECT_EQ(s.format, SampleFormat::kRate);
   EXPECT_EQ(s.layout, FileLayout::kBinary);
   EXPECT_EQ(s.axle_sign, 1);
-  expect_same_noise(s.noise, ImuNoise{});
+  // No noise stated: ImuNoise's defaults, with the velocity random walk of a wheel module.
+  ImuNoise defaults;
+  defaults.acc_vrw = kDefaultWheelVrw;
+  expect_same_noise(s.noise, defaults);
+  EXPECT_EQ(s.noise_stated, 0u);
   EXPECT_EQ(m.resolve(s.file), m.path.parent_path() / "left.bin");
   EXPECT_EQ(m.resolve("/x/y.bin"), std::filesystem::path("/x/y.bin"));
   EXPECT_EQ(m.find("left"), &m.modules[0]);

@@ -157,7 +157,9 @@ TEST_F(NavEndToEnd, CovariancesStaySymmetricPositiveDefinite) {
       if (centralized) continue;  // the joint covariance is checked through its blocks below
       const Mat21& P = navigator.subsystem(k).ekf().covariance();
       EXPECT_LT((P - P.transpose()).cwiseAbs().maxCoeff(), 1e-12 * P.cwiseAbs().maxCoeff());
-      const Eigen::SelfAdjointEigenSolver<Mat21> es(P);
+      // Held states (not estimated) have zero rows by construction.
+      const Eigen::SelfAdjointEigenSolver<Mat21> es(
+          estimated_block(P, navigator.subsystem(k).process_noise()));
       EXPECT_GT(es.eigenvalues().minCoeff(), 0.0) << "subsystem " << k;
     }
   }
@@ -172,7 +174,8 @@ TEST_F(NavEndToEnd, RunWritesFilesAndNeverOverwritesUnasked) {
   r.progress = false;
   r.max_duration = 20.0;
   const RunResult first = run_navigation(r);
-  ASSERT_EQ(first.files.size(), 6u);  // csv, tum, kml + one csv per subsystem + faults.csv
+  ASSERT_EQ(first.files.size(), 7u);  // csv, tum, kml, one csv per subsystem, faults.csv, noise.yaml
+  EXPECT_TRUE(fs::exists(out / "noise.yaml"));
   for (const auto& f : first.files) EXPECT_TRUE(fs::exists(f)) << f;
   const auto size = fs::file_size(out / "trajectory.csv");
   try {

@@ -3,10 +3,13 @@
 // earth rate), heading given (the paper takes it from the reference system).
 #pragma once
 
+#include "wheelins/filter/noise_identification.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins {
 
+/// The samples of the static period: their means (the alignment) and the Allan variance of
+/// each sensor (the noise at rest, noise_identification.hpp).
 class StaticAccumulator {
  public:
   void add(const ImuSample& s) {
@@ -14,16 +17,23 @@ class StaticAccumulator {
     sum_dvel_ += s.dvel;
     sum_dt_ += s.dt;
     ++count_;
+    if (s.dt > 0.0) {
+      gyro_.add(s.dtheta / s.dt, s.dt);
+      accel_.add(s.dvel / s.dt, s.dt);
+    }
   }
   int count() const { return count_; }
   double duration() const { return sum_dt_; }
   Vec3 mean_omega() const { return sum_dtheta_ / sum_dt_; }
   Vec3 mean_f() const { return sum_dvel_ / sum_dt_; }
+  const AllanAccumulator& gyro_allan() const { return gyro_; }
+  const AllanAccumulator& accel_allan() const { return accel_; }
 
  private:
   Vec3 sum_dtheta_ = Vec3::Zero(), sum_dvel_ = Vec3::Zero();
   double sum_dt_ = 0.0;
   int count_ = 0;
+  AllanAccumulator gyro_, accel_;
 };
 
 /// Roll and pitch of the b-frame from a static mean specific force (f^b = -C_n^b g^n).

@@ -8,7 +8,15 @@ namespace wheelins {
 
 BodyIns::BodyIns(const ImuModule& module, const BodyInsOptions& opt,
                  const MechanizationOptions& mech)
-    : Subsystem(module, mech), opt_(opt), C_BtoV_(dcm_from_euler(module.mounting_rpy)) {}
+    : Subsystem(module, mech), opt_(opt), C_BtoV_(dcm_from_euler(module.mounting_rpy)) {
+  // The scale factor of the gyro axis nearest the vehicle's yaw axis is a yaw-rate scale
+  // factor: unobservable without a heading reference, so held (docs/filter.md 13.4).
+  if (!opt.estimate_yaw_scale_factor) {
+    int axis = 0;
+    C_BtoV_.row(2).cwiseAbs().maxCoeff(&axis);
+    noise_.estimated(SG + axis) = 0.0;
+  }
+}
 
 void BodyIns::start(const StaticAccumulator& stat, double vehicle_heading, double t0) {
   NavState s;
@@ -18,7 +26,7 @@ void BodyIns::start(const StaticAccumulator& stat, double vehicle_heading, doubl
   s.p_IinW = C * C_BtoV_.transpose() * module_.p_inV;  // o at the origin
   ImuErrors e;
   e.bg = stat.mean_omega() - C.transpose() * mech_.omega_ie_inW;
-  ekf_.initialize(s, e, module_.noise, opt_.init, mech_);
+  ekf_.initialize(s, e, noise_, opt_.init, mech_);
 }
 
 void BodyIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
@@ -28,7 +36,7 @@ void BodyIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
   s.q_ItoW = Quat(C).normalized();
   s.p_IinW = fix.p_OinW + C * C_BtoV_.transpose() * module_.p_inV;
   s.v_IinW = fix.v_OinW;
-  ekf_.initialize(s, ekf_.errors(), module_.noise, fix.uncertainty(), mech_);
+  ekf_.initialize(s, ekf_.errors(), noise_, fix.uncertainty(), mech_);
 }
 
 Eigen::RowVector3d BodyIns::heading_sensitivity() const {

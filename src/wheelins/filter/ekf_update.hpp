@@ -29,11 +29,12 @@ struct UpdateReport {
 /// Fuses one measurement of dimension M into (P, dx) of an N-dimensional error state: a
 /// subsystem's 21 states, or the stacked states of all IMUs (the centralized filter). With
 /// gate > 0, rejects it (P and dx untouched) when test_ratio > gate. Joseph form keeps P
-/// positive.
+/// positive. `K_out` (optional) receives the gain of an accepted update.
 template <int M, int N>
 UpdateReport ekf_update(Eigen::Matrix<double, N, N>& P, Eigen::Matrix<double, N, 1>& dx,
                         const Eigen::Matrix<double, M, N>& H, const Eigen::Matrix<double, M, 1>& dz,
-                        const Eigen::Matrix<double, M, M>& R, double gate = 0.0) {
+                        const Eigen::Matrix<double, M, M>& R, double gate = 0.0,
+                        Eigen::Matrix<double, N, M>* K_out = nullptr) {
   static_assert(M >= 1 && M <= 6);
   using MatM = Eigen::Matrix<double, M, M>;
   using MatNM = Eigen::Matrix<double, N, M>;
@@ -54,6 +55,7 @@ UpdateReport ekf_update(Eigen::Matrix<double, N, N>& P, Eigen::Matrix<double, N,
   if (gate > 0.0 && rep.test_ratio > gate) return rep;
 
   const MatNM K = llt.solve(PHt.transpose()).transpose();
+  if (K_out) *K_out = K;
   dx += K * (dz - H.lazyProduct(dx));
   // Joseph form (I - KH) P (I - KH)^T + K R K^T, multiplied out so that no n x n x n
   // product is formed: P - K (PH^T)^T - (PH^T) K^T + K S K^T (S = HPH^T + R). The

@@ -33,7 +33,7 @@ Vec21 noise_density(const ProcessNoise& q) {
   qc.segment<3>(BA).setConstant(2.0 * q.acc_bias_std * q.acc_bias_std / q.acc_bias_tau);
   qc.segment<3>(SG).setConstant(2.0 * q.gyro_sf_std * q.gyro_sf_std / q.gyro_sf_tau);
   qc.segment<3>(SA).setConstant(2.0 * q.acc_sf_std * q.acc_sf_std / q.acc_sf_tau);
-  return qc;
+  return qc.cwiseProduct(q.estimated);
 }
 }  // namespace
 

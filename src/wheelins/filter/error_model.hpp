@@ -7,9 +7,31 @@
 
 namespace wheelins {
 
-/// The noise model of the error states is the module's ImuNoise (SI): white noise
-/// densities (ARW, VRW) and first-order Gauss-Markov sigmas and correlation times.
-using ProcessNoise = ImuNoise;
+/// The noise model of the error states: the module's figures (ImuNoise, SI: white noise
+/// densities ARW and VRW, first-order Gauss-Markov sigmas and correlation times), and which
+/// states the filter estimates. A state that is not estimated (estimated(k) == 0) is held at
+/// its estimate: no process noise and no initial uncertainty, so its row and column of P stay
+/// zero through every time update (Phi's row of a Gauss-Markov state is its decay alone) and
+/// every measurement update (its gain row is zero). docs/filter.md section 13.4.
+struct ProcessNoise : ImuNoise {
+  ProcessNoise() = default;
+  ProcessNoise(const ImuNoise& n) : ImuNoise(n) {}  // NOLINT(google-explicit-constructor)
+  Vec21 estimated = Vec21::Ones();
+  bool held(int k) const { return estimated(k) == 0.0; }
+};
+
+/// P for a positive-definiteness test: the rows and columns of the held states (zero by
+/// construction) replaced by those of the identity.
+inline Mat21 estimated_block(const Mat21& P, const ProcessNoise& q) {
+  Mat21 out = P;
+  for (int k = 0; k < kStateDim; ++k)
+    if (q.held(k)) {
+      out.row(k).setZero();
+      out.col(k).setZero();
+      out(k, k) = 1.0;
+    }
+  return out;
+}
 
 /// The continuous-time error dynamics F of eq. (2):
 ///   d(dr)  = dv

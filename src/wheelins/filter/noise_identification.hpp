@@ -9,14 +9,12 @@
 // or only a bound on it when the curve still falls as tau^-1/2 at the longest
 // cluster time the period allows (a 30 s period cannot show a MEMS gyro's floor).
 //
-// In motion: the innovations of the velocity updates (covariance matching, Mehra
-// 1970; Mohamed & Schwarz 1999): over a window of updates, the innovation variance
-// per axis E[dz_i^2] is matched to its prediction S_i = (H P H^T)_i + R_i. Process
-// noise is isotropic (the velocity random walk enters every axis of a velocity
-// measurement alike, H's velocity block being a rotation), measurement noise is per
-// axis (wheel speed, lateral and vertical constraint): so the part of the excess
-// common to the constraint axes is the velocity random walk, and what is left on
-// each axis its measurement noise (VelocityNoiseMatcher).
+// In motion: the innovations of a velocity update, by Mehra's (1970) correlation
+// method (VelocityNoiseMatcher): their variance alone cannot tell measurement noise
+// from process noise at one update rate (covariance matching, Mohamed & Schwarz 1999),
+// their lag-one correlation can. The velocity random walk enters every axis alike (H's
+// velocity block is a rotation) and is taken from the constraint axes; the measurement
+// noise is per axis (wheel speed, lateral and vertical constraint).
 //
 // The gyro bias instability in motion: its random walk from the corrections the
 // updates make to the bias estimate (Mohamed & Schwarz's Q = K C K^T on the bias

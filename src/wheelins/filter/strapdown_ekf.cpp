@@ -25,6 +25,21 @@ void StrapdownEkf::initialize(const NavState& state, const ImuErrors& errors,
   P_.block<3, 3>(BA, BA).diagonal().setConstant(noise.acc_bias_std * noise.acc_bias_std);
   P_.block<3, 3>(SG, SG).diagonal().setConstant(noise.gyro_sf_std * noise.gyro_sf_std);
   P_.block<3, 3>(SA, SA).diagonal().setConstant(noise.acc_sf_std * noise.acc_sf_std);
+  P_.diagonal() = P_.diagonal().cwiseProduct(noise.estimated);  // held states: no uncertainty
+  ++starts_;
+  S_.setZero();
+  held_var_.setZero();
+  n_held_ = 0;
+  for (int k = 0; k < kStateDim; ++k)
+    if (noise.held(k)) {
+      if (n_held_ == kMaxHeld)
+        throw InputError("at most 3 error states can be held (not estimated) per IMU");
+      held_[n_held_] = k;
+      held_var_(n_held_) = held_state_variance(noise, k);
+      S_(k, n_held_) = 1.0;
+      ++n_held_;
+    }
+  reported_dirty_ = true;
   initialized_ = true;
 }
 
@@ -67,7 +82,10 @@ void StrapdownEkf::clear_pending() {
 
 void StrapdownEkf::flush_covariance() {
   if (pending_dt_ <= 0.0) return;
-  propagate_covariance(P_, pending_dynamics(), noise_, pending_dt_);
+  const ErrorDynamics d = pending_dynamics();
+  propagate_covariance(P_, d, noise_, pending_dt_);
+  if (n_held_) apply_transition<kMaxHeld>(d, pending_dt_, S_);
+  reported_dirty_ = true;
   clear_pending();
 }
 
@@ -80,6 +98,46 @@ void StrapdownEkf::feedback(const Vec21& dx) {
   errors_.ba += dx.segment<3>(BA);
   errors_.sg += dx.segment<3>(SG);
   errors_.sa += dx.segment<3>(SA);
+}
+
+void StrapdownEkf::set_noise(const ProcessNoise& noise) {
+  // The held states must stay what they were at initialize(): their rows of P are zero.
+  noise_.gyro_arw = noise.gyro_arw;
+  noise_.acc_vrw = noise.acc_vrw;
+  noise_.gyro_bias_std = noise.gyro_bias_std;
+  noise_.acc_bias_std = noise.acc_bias_std;
+  noise_.gyro_sf_std = noise.gyro_sf_std;
+  noise_.acc_sf_std = noise.acc_sf_std;
+}
+
+void StrapdownEkf::set_gyro_bias_uncertainty(double sigma) {
+  P_.middleRows<3>(BG).setZero();
+  P_.middleCols<3>(BG).setZero();
+  P_.block<3, 3>(BG, BG).diagonal().setConstant(sigma * sigma);
+  P_.diagonal() = P_.diagonal().cwiseProduct(noise_.estimated);
+  reported_dirty_ = true;
+}
+
+const Mat21& StrapdownEkf::reported_covariance() const {
+  if (!n_held_) return P_;
+  // P changes at the covariance steps and the updates only; the records between them (every
+  // epoch) read the cache.
+  if (reported_dirty_) {
+    const Eigen::Matrix<double, kStateDim, kMaxHeld> SV = S_ * held_var_.asDiagonal();
+    reported_ = P_ + SV.lazyProduct(S_.transpose());
+    reported_ = 0.5 * (reported_ + reported_.transpose()).eval();
+    reported_dirty_ = false;
+  }
+  return reported_;
+}
+
+double held_state_variance(const ProcessNoise& q, int k) {
+  const double s = k >= SA   ? q.acc_sf_std
+                   : k >= SG ? q.gyro_sf_std
+                   : k >= BA ? q.acc_bias_std
+                   : k >= BG ? q.gyro_bias_std
+                             : 0.0;
+  return s * s;
 }
 
 }  // namespace wheelins

@@ -4,6 +4,8 @@
 // are built on it; each measurement model lives in its own file.
 #pragma once
 
+#include <array>
+
 #include "wheelins/filter/ekf_update.hpp"
 #include "wheelins/filter/error_model.hpp"
 #include "wheelins/nav/mechanization.hpp"
@@ -55,6 +57,13 @@ class StrapdownEkf {
   double pending_dt() const { return pending_dt_; }
   void clear_pending();
   const ProcessNoise& noise() const { return noise_; }
+  /// New noise figures from here on (noise identification, fusion/noise_adaptation.hpp): the
+  /// white noise densities and Gauss-Markov sigmas; which states are estimated stays as
+  /// initialize() set it.
+  void set_noise(const ProcessNoise& noise);
+  /// The gyro-bias uncertainty after the alignment (its accuracy, from the static data),
+  /// uncorrelated with the other states; only before the first update.
+  void set_gyro_bias_uncertainty(double sigma);
 
   /// Fuses a measurement (dz = z_hat - z_meas = H dx + e) and feeds the error back.
   template <int M>
@@ -63,10 +72,31 @@ class StrapdownEkf {
                       double gate = 0.0) {
     flush_covariance();
     Vec21 dx = Vec21::Zero();
-    const UpdateReport rep = ekf_update<M>(P_, dx, H, dz, R, gate);
-    if (rep.accepted) feedback(dx);
+    Eigen::Matrix<double, kStateDim, M> K;
+    const UpdateReport rep = ekf_update<M>(P_, dx, H, dz, R, gate, &K);
+    if (rep.accepted) {
+      feedback(dx);
+      // The held states' effect on the estimated ones, through this update (H S includes
+      // their own columns of H: S has a 1 in each held state's row).
+      if (n_held_) S_ -= K * (H * S_);
+      reported_dirty_ = true;
+    }
     return rep;
   }
+
+  /// Consider analysis of the held states (docs/filter.md section 13.4): their prior
+  /// uncertainty does not enter the gains, but what it does to the estimated states is
+  /// carried in the sensitivity S = d(error)/d(held state value), propagated by the same Phi
+  /// and updated by the same gains. The covariance to report (and to test against the
+  /// truth) is P + S diag(sigma_held^2) S^T; the held states' own rows and columns are
+  /// theirs.
+  const Mat21& reported_covariance() const;
+  static constexpr int kMaxHeld = 3;
+  int held_count() const { return n_held_; }
+  const Eigen::Matrix<double, kStateDim, kMaxHeld>& held_sensitivity() const { return S_; }
+  /// The prior variances of the held states (the columns of S).
+  const Eigen::Matrix<double, kMaxHeld, 1>& held_variance() const { return held_var_; }
+  const std::array<int, kMaxHeld>& held_states() const { return held_; }
 
   const NavState& state() const { return state_; }
   const ImuErrors& errors() const { return errors_; }
@@ -85,6 +115,8 @@ class StrapdownEkf {
   const ImuSample& last_compensated() const { return last_; }
   const MechanizationOptions& mechanization() const { return mech_; }
   bool initialized() const { return initialized_; }
+  /// How many times initialize() ran (a restart starts the filter again).
+  int starts() const { return starts_; }
 
   /// Applies an error estimate (position, velocity, attitude, sensor errors) to the state.
   void feedback(const Vec21& dx);
@@ -104,6 +136,17 @@ class StrapdownEkf {
   ImuSample last_raw_;
   bool have_last_ = false;
   bool initialized_ = false;
+  int starts_ = 0;
+  // Consider analysis of the held states (reported_covariance).
+  Eigen::Matrix<double, kStateDim, kMaxHeld> S_ = Eigen::Matrix<double, kStateDim, kMaxHeld>::Zero();
+  Eigen::Matrix<double, kMaxHeld, 1> held_var_ = Eigen::Matrix<double, kMaxHeld, 1>::Zero();
+  std::array<int, kMaxHeld> held_{};
+  int n_held_ = 0;
+  mutable Mat21 reported_ = Mat21::Zero();  ///< cache of reported_covariance()
+  mutable bool reported_dirty_ = true;
 };
+
+/// The prior variance a held state stands for (its noise figure squared).
+double held_state_variance(const ProcessNoise& q, int k);
 
 }  // namespace wheelins

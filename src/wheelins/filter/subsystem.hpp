@@ -56,7 +56,7 @@ class MotionAccumulator {
 class Subsystem {
  public:
   Subsystem(const ImuModule& module, const MechanizationOptions& mech)
-      : module_(module), mech_(mech) {}
+      : module_(module), mech_(mech), noise_(module.noise) {}
   virtual ~Subsystem() = default;
   Subsystem(const Subsystem&) = delete;
   Subsystem& operator=(const Subsystem&) = delete;
@@ -88,9 +88,19 @@ class Subsystem {
 
   Vec3 reference_point_inW() const { return reference_point_model(reference_point_input()).r_o; }
 
+  /// The noise model in use: the module's figures, as the noise identification has set them
+  /// since (fusion/noise_adaptation.hpp), and which states are estimated. Restarts keep it.
+  const ProcessNoise& process_noise() const { return noise_; }
+  /// New figures from here on (the estimated states stay as they are).
+  void set_process_noise(const ImuNoise& q) {
+    static_cast<ImuNoise&>(noise_) = q;
+    ekf_.set_noise(noise_);
+  }
+
  protected:
   ImuModule module_;
   MechanizationOptions mech_;
+  ProcessNoise noise_;
   StrapdownEkf ekf_;
 };
 

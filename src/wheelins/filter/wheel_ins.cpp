@@ -15,6 +15,15 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
       axle_sign_(module.axle_sign) {
   window_len_ = std::clamp(static_cast<int>(std::lround(opt.speed_window * module.rate_hz)), 1,
                            kMaxWindow);
+  // The gyro axes in the wheel plane see the vehicle's yaw rate in turn as the wheel rolls:
+  // their scale factors together are a yaw-rate scale factor, which nothing but a heading
+  // reference could show; estimated from the velocity updates they run away with the
+  // innovations' unmodelled errors. Held (docs/filter.md 13.4). The axle's (x) is estimated:
+  // the wheel angle it integrates is checked against gravity at every update.
+  if (!opt.estimate_yaw_scale_factor) noise_.estimated(SG + 1) = noise_.estimated(SG + 2) = 0.0;
+  // The accelerometer along the axle sees the lateral specific force only: its scale factor
+  // and its bias differ only where the course turns both ways (held as well).
+  if (!opt.estimate_axle_accel_scale_factor) noise_.estimated(SA + 0) = 0.0;
 }
 
 ImuSample WheelIns::to_body(const ImuSample& s) const {
@@ -41,7 +50,7 @@ void WheelIns::start(const StaticAccumulator& stat, double vehicle_heading, doub
 }
 
 void WheelIns::begin(const NavState& s, const ImuErrors& e, const InitialUncertainty& init) {
-  ekf_.initialize(s, e, module_.noise, init, mech_);
+  ekf_.initialize(s, e, noise_, init, mech_);
   window_count_ = window_pos_ = 0;
   window_sum_ = 0.0;
 }

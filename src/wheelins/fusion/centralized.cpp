@@ -2,6 +2,7 @@
 // IMUs (block time update, the update through ekf_update) and its back-end.
 #include "wheelins/fusion/centralized.hpp"
 
+#include <array>
 #include <string>
 
 #include "wheelins/nav/types.hpp"
@@ -12,20 +13,45 @@ namespace {
 template <int N>
 class FixedJointCovariance final : public JointCovariance {
   static constexpr int D = kStateDim * N;
+  static constexpr int C = StrapdownEkf::kMaxHeld * N;  ///< consider columns
   using MatD = Eigen::Matrix<double, D, D>;
   using H3D = Eigen::Matrix<double, 3, D>;
 
  public:
-  FixedJointCovariance() { P_.setZero(); }
+  FixedJointCovariance() {
+    P_.setZero();
+    S_.setZero();
+    var_.setZero();
+    dirty_.fill(true);
+  }
   int size() const override { return N; }
 
   void set_block(int i, const Mat21& P) override {
     P_.template block<kStateDim, kStateDim>(kStateDim * i, kStateDim * i) = P;
+    dirty_.fill(true);
   }
   void reset(int i, const Mat21& P) override {
     P_.template middleRows<kStateDim>(kStateDim * i).setZero();
     P_.template middleCols<kStateDim>(kStateDim * i).setZero();
     set_block(i, P);
+  }
+  void set_consider(int i, const StrapdownEkf& ekf) override {
+    constexpr int H = StrapdownEkf::kMaxHeld;
+    S_.template middleRows<kStateDim>(kStateDim * i).setZero();
+    S_.template middleCols<H>(H * i).setZero();
+    S_.template block<kStateDim, H>(kStateDim * i, H * i) = ekf.held_sensitivity();
+    var_.template segment<H>(H * i) = ekf.held_variance();
+    dirty_.fill(true);
+  }
+  const Mat21& reported_block(int i) const override {
+    if (dirty_[i]) {
+      const auto Si = S_.template middleRows<kStateDim>(kStateDim * i);
+      const Eigen::Matrix<double, kStateDim, C> SV = Si * var_.asDiagonal();
+      Mat21 out = block(i) + SV.lazyProduct(Si.transpose());
+      reported_[i] = 0.5 * (out + out.transpose());
+      dirty_[i] = false;
+    }
+    return reported_[i];
   }
   Mat21 block(int i) const override {
     return P_.template block<kStateDim, kStateDim>(kStateDim * i, kStateDim * i);
@@ -41,6 +67,11 @@ class FixedJointCovariance final : public JointCovariance {
     rows = P_.template middleCols<kStateDim>(o).transpose();
     apply_transition<D>(d, dt, rows);
     P_.template middleCols<kStateDim>(o) = rows.transpose();
+    // The held states' sensitivities of this IMU move with its Phi (consider analysis).
+    Eigen::Matrix<double, kStateDim, C> srows = S_.template middleRows<kStateDim>(o);
+    apply_transition<C>(d, dt, srows);
+    S_.template middleRows<kStateDim>(o) = srows;
+    dirty_[i] = true;
     auto Pii = P_.template block<kStateDim, kStateDim>(o, o);
     Pii.diagonal() += discrete_noise_diagonal(q, dt);
     const Mat21 sym = 0.5 * (Mat21(Pii) + Mat21(Pii).transpose());
@@ -56,13 +87,22 @@ class FixedJointCovariance final : public JointCovariance {
     // The one EKF update (filter/ekf_update.hpp) over the stacked error state; the error
     // estimate starts at zero (every subsystem is fed back after each update).
     Eigen::Matrix<double, D, 1> dxb = Eigen::Matrix<double, D, 1>::Zero();
-    const UpdateReport rep = ekf_update<3, D>(P_, dxb, Hb, dz, R, gate);
+    Eigen::Matrix<double, D, 3> K;
+    const UpdateReport rep = ekf_update<3, D>(P_, dxb, Hb, dz, R, gate, &K);
+    if (rep.accepted) {
+      S_ -= K * (Hb * S_);
+      dirty_.fill(true);
+    }
     for (int j = 0; j < N; ++j) dx[j] = dxb.template segment<kStateDim>(kStateDim * j);
     return rep;
   }
 
  private:
   MatD P_;
+  Eigen::Matrix<double, D, C> S_;    ///< held states' sensitivities (consider analysis)
+  Eigen::Matrix<double, C, 1> var_;  ///< their prior variances
+  mutable std::array<Mat21, N> reported_;
+  mutable std::array<bool, N> dirty_{};
 };
 
 }  // namespace
@@ -83,7 +123,10 @@ CentralizedFilter::CentralizedFilter(Subsystems& subs)
     : subs_(subs), joint_(make_joint_covariance(subs.size())) {}
 
 void CentralizedFilter::start() {
-  for (int i = 0; i < subs_.size(); ++i) joint_->set_block(i, subs_[i].ekf().covariance());
+  for (int i = 0; i < subs_.size(); ++i) {
+    joint_->set_block(i, subs_[i].ekf().covariance());
+    joint_->set_consider(i, subs_[i].ekf());
+  }
 }
 
 void CentralizedFilter::propagate_joint(int i) {
@@ -116,6 +159,9 @@ UpdateReport CentralizedFilter::fuse(const Measurement& m) {
   return rep;
 }
 
-void CentralizedFilter::restarted(int i) { joint_->reset(i, subs_[i].ekf().covariance()); }
+void CentralizedFilter::restarted(int i) {
+  joint_->reset(i, subs_[i].ekf().covariance());
+  joint_->set_consider(i, subs_[i].ekf());
+}
 
 }  // namespace wheelins

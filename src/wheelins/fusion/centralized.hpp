@@ -11,6 +11,7 @@
 
 #include "wheelins/filter/ekf_update.hpp"
 #include "wheelins/filter/error_model.hpp"
+#include "wheelins/filter/strapdown_ekf.hpp"
 #include "wheelins/fusion/filter_backend.hpp"
 
 namespace wheelins {
@@ -26,6 +27,12 @@ class JointCovariance {
   virtual Mat21 block(int i) const = 0;
   /// Subsystem i restarted with covariance P: its cross-covariances with the others are 0.
   virtual void reset(int i, const Mat21& P) = 0;
+  /// Subsystem i's held states (StrapdownEkf::held_states): their sensitivities start as the
+  /// subsystem's (its rows only) and their prior variances are taken (consider analysis).
+  virtual void set_consider(int i, const StrapdownEkf& ekf) = 0;
+  /// Block i with the held states' consider terms: P_ii + S_i V S_i^T (cached between the
+  /// time and measurement updates that change it).
+  virtual const Mat21& reported_block(int i) const = 0;
   /// Subsystem i advanced by one epoch (F_i over dt); the others did not move.
   virtual void propagate(int i, const ErrorDynamics& d, const ProcessNoise& q, double dt) = 0;
   /// Fuses dz = sum_j H_j dx_j + e (H[j] == nullptr: no dependence on subsystem j),
@@ -49,6 +56,7 @@ class CentralizedFilter final : public FilterBackend {
   void propagated(int i) override;
   void flush() override;
   const Mat21& covariance(int i, Mat21& scratch) const override;
+  const Mat21& reported_covariance(int i) const override { return joint_->reported_block(i); }
   UpdateReport fuse(const Measurement& m) override;
   void restarted(int i) override;
 

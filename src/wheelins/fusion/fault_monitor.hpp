@@ -30,7 +30,7 @@ struct FaultOptions {
   double realign_time = 0.5;        ///< [s] of data levelling a module that comes back
   double probation = 10.0;          ///< [s] a module that came back is tied to the others first
   double retry_after = 10.0;        ///< [s] an isolated module is re-initialised after this
-  double speed_gate = 15.0;         ///< [sigma] a wheel speed disagreeing more is not used
+  double speed_gate = 5.0;          ///< [sigma] a wheel speed disagreeing more is not used
   double wheel_mismatch = 0.15;     ///< [m/s] wheel speeds further apart (or 10 %) disagree
   double test_ratio = 10.0;         ///< velocity test ratio counted as failed by the detector
   int window = 20;                  ///< the detector's window of velocity tests (<= 64)

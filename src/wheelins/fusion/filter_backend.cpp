@@ -22,6 +22,9 @@ class DistributedFilter final : public FilterBackend {
     for (int i = 0; i < subs_.size(); ++i) subs_[i].ekf().flush_covariance();
   }
   const Mat21& covariance(int i, Mat21&) const override { return subs_[i].ekf().covariance(); }
+  const Mat21& reported_covariance(int i) const override {
+    return subs_[i].ekf().reported_covariance();
+  }
   UpdateReport fuse(const Measurement& m) override {
     return subs_[m.module].ekf().update<3>(m.H_own, m.dz, m.R, m.gate);
   }

@@ -32,6 +32,9 @@ class FilterBackend {
   /// Subsystem i's covariance (its block of a joint covariance, copied into `scratch`), as of
   /// its last time update.
   virtual const Mat21& covariance(int i, Mat21& scratch) const = 0;
+  /// Subsystem i's covariance to report (the output's sigmas): with the consider terms of
+  /// its held states (StrapdownEkf::reported_covariance), at its last time update.
+  virtual const Mat21& reported_covariance(int i) const = 0;
   /// Fuses `m` and feeds the error estimate back into the subsystem(s).
   virtual UpdateReport fuse(const Measurement& m) = 0;
   /// Subsystem i was re-initialised: its covariance is its own new one, uncorrelated.

@@ -20,7 +20,8 @@ Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& 
       subs_(setup, modules, options),
       filter_(make_filter_backend(subs_, options.fusion.centralized)),
       output_(subs_, *filter_, frame_, opt_, std::move(sink)),
-      faults_(make_fault_handler(opt_.faults, subs_, *filter_, output_)) {
+      faults_(make_fault_handler(opt_.faults, subs_, *filter_, output_)),
+      noise_(opt_.noise, subs_, opt_.wheel.velocity_update_interval) {
   opt_.validate();
   static_.resize(subs_.size());
 }
@@ -93,6 +94,7 @@ void Navigator::start_navigation(double t0) {
                        "': the alignment needs the static period covered by every module's data");
     }
     subs_[i].start(static_[i], initial_heading_, t0);
+    noise_.on_start(i, static_[i], t0);
   }
   filter_->start();
   faults_->on_start(t0);
@@ -126,7 +128,11 @@ void Navigator::velocity_step() {
       take_speeds(sh, false);
     }
     wheelins::velocity_measurement(subs_, sh, opt_.fusion, i, joint, meas_);
-    count_velocity_update(i, filter_->fuse(meas_), t);
+    noise_.prepare_velocity(i, meas_);
+    const Vec3 bias_before = subs_[i].ekf().errors().bg;
+    const UpdateReport rep = filter_->fuse(meas_);
+    noise_.after_velocity(i, meas_, rep, bias_before, t);
+    count_velocity_update(i, rep, t);
   }
 }
 
@@ -210,7 +216,9 @@ void Navigator::position_step() {
       take_reference(sh, false);
     }
     wheelins::position_measurement(subs_, sh, opt_.fusion, i, meas_);
-    record(filter_->fuse(meas_));
+    const UpdateReport rep = filter_->fuse(meas_);
+    noise_.after_position(i, rep);
+    record(rep);
   }
 }
 
@@ -288,7 +296,8 @@ void Navigator::check_covariances() {
     if (scale > 0.0)
       stats_.max_covariance_asymmetry = std::max(
           stats_.max_covariance_asymmetry, (P - P.transpose()).cwiseAbs().maxCoeff() / scale);
-    const Eigen::LLT<Mat21> llt(P);
+    // The held states' rows are zero by construction (not estimated, filter/error_model.hpp).
+    const Eigen::LLT<Mat21> llt(estimated_block(P, subs_[i].process_noise()));
     if (llt.info() != Eigen::Success || !(scale > 0.0)) ++stats_.covariance_not_pd;
   }
 }

@@ -16,6 +16,7 @@
 //   FilterBackend  distributed (the paper) or centralized     (filter_backend.hpp)
 //   OutputFusion   the vehicle solution and the records       (output.hpp)
 //   FaultHandler   sensor faults, behind a few hooks          (fault_handler.hpp)
+//   NoiseAdaptation the noise model learned from the data     (noise_adaptation.hpp)
 #pragma once
 
 #include <array>
@@ -26,6 +27,7 @@
 #include "wheelins/fusion/fault_handler.hpp"
 #include "wheelins/fusion/filter_backend.hpp"
 #include "wheelins/fusion/measurement.hpp"
+#include "wheelins/fusion/noise_adaptation.hpp"
 #include "wheelins/fusion/options.hpp"
 #include "wheelins/fusion/output.hpp"
 #include "wheelins/fusion/subsystems.hpp"
@@ -73,6 +75,9 @@ class Navigator {
   const FaultMonitor& faults() const { return faults_->monitor(); }
   /// Closes the fault statistics at the end of the data.
   void finish();
+  /// What the noise identification found for subsystem i, with the consistency figures and
+  /// the warnings (noise_adaptation.hpp).
+  ModuleNoiseReport noise_report(int i) const { return noise_.report(i); }
 
  private:
   using Use = std::array<bool, kMaxModules>;
@@ -115,6 +120,7 @@ class Navigator {
   std::unique_ptr<FilterBackend> filter_;
   OutputFusion output_;
   std::unique_ptr<FaultHandler> faults_;
+  NoiseAdaptation noise_;
   std::vector<StaticAccumulator> static_;
   SharedInputs shared_;    ///< scratch of the update steps (no allocation per epoch)
   Measurement meas_;       ///< scratch of the update steps

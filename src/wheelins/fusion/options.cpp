@@ -35,11 +35,37 @@ std::string NavigatorOptions::describe() const {
     << (covariance_interval > 0 ? "every " + std::to_string(covariance_interval) + " s"
                                 : std::string("every epoch"))
     << "\n"
+    << "noise model:                "
+    << (noise.enabled ? "identified from the data (rest: Allan variance; motion: Mehra, window " +
+                            std::to_string(static_cast<int>(noise.window)) + " updates)"
+                      : std::string("the given figures, held fixed"))
+    << "\n"
+    << "yaw-rate scale factors:     "
+    << (wheel.estimate_yaw_scale_factor ? "estimated" : "held (unobservable without a heading reference)")
+    << "\n"
+    << "axle accelerometer SF:      "
+    << (wheel.estimate_axle_accel_scale_factor ? "estimated" : "held (not told from its bias on one-way turns)")
+    << "\n"
     << faults.describe()
     << "output interval:            "
     << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
     << "\n";
   return o.str();
+}
+
+void NoiseAdaptationOptions::validate() const {
+  auto fail = [](const char* what, double v) {
+    char got[48];
+    std::snprintf(got, sizeof got, ", got %.17g", v);
+    throw InputError(what + std::string(got));
+  };
+  if (!(window >= 5.0 && window <= 1e5)) fail("noise adaptation window: must be in [5, 1e5] updates", window);
+  if (!(r_floor_fraction > 0.0 && r_floor_fraction <= 1.0))
+    fail("noise adaptation: the measurement-noise floor must be in (0, 1] of its given sigma", r_floor_fraction);
+  if (!(vrw_max > 0.0 && std::isfinite(vrw_max))) fail("noise adaptation: vrw_max must be > 0", vrw_max);
+  if (!(min_speed >= 0.0 && std::isfinite(min_speed))) fail("noise adaptation: min_speed must be >= 0", min_speed);
+  if (!(settle >= 0.0 && std::isfinite(settle))) fail("noise adaptation: settle must be >= 0 s", settle);
+  if (!(bias_floor >= 0.0 && std::isfinite(bias_floor))) fail("noise adaptation: bias floor must be >= 0", bias_floor);
 }
 
 void NavigatorOptions::validate() const {
@@ -59,6 +85,7 @@ void NavigatorOptions::validate() const {
     fail("position update interval: must be > 0 s", fusion.position_update_interval);
   if (!(fusion.position_std > 0.0) || !std::isfinite(fusion.position_std))
     fail("position constraint sigma: must be > 0 m", fusion.position_std);
+  noise.validate();
 }
 
 }  // namespace wheelins

@@ -33,6 +33,18 @@ struct FusionOptions {
   bool centralized = false;
 };
 
+/// The noise model learned from the data (noise_adaptation.hpp, docs/filter.md section 13).
+struct NoiseAdaptationOptions {
+  bool enabled = true;            ///< false: the given figures are held fixed (only reported)
+  double window = 60.0;           ///< velocity updates the in-motion estimates weigh (e-folding)
+  double r_floor_fraction = 0.5;  ///< measurement noise never below this share of its given sigma
+  double vrw_max = 20.0 / 60.0;   ///< [m/s/sqrt(s)]
+  double min_speed = 0.2;         ///< [m/s]: at rest speed and constraints are exact, not noisy
+  double settle = 10.0;           ///< [s] after a start before innovations count
+  double bias_floor = 5.0 * kDeg / 3600.0;  ///< Wheel-IMU gyro bias instability floor [rad/s]
+  void validate() const;
+};
+
 struct NavigatorOptions {
   WheelInsOptions wheel;
   BodyInsOptions body;
@@ -42,6 +54,8 @@ struct NavigatorOptions {
   bool earth_rotation = true;
   /// Sensor-fault handling: outages, saturation, slip, isolation of faulty IMUs.
   FaultOptions faults;
+  /// Noise identification from the data (off: the given figures held fixed).
+  NoiseAdaptationOptions noise;
   /// Output interval [s]; 0 = every epoch of the first module.
   double output_interval = 0.0;
   /// Also send each subsystem's own solution to the sink (streams 1..N) of a multi-IMU run.

@@ -33,8 +33,8 @@ OutputFusion::OutputFusion(const Subsystems& subs, const FilterBackend& filter,
 TrajectoryRecord OutputFusion::record(int i, bool with_lla) const {
   const Subsystem& s = subs_[i];
   const StrapdownEkf& ekf = s.ekf();
-  Mat21 scratch;
-  const Mat21& P = filter_.covariance(i, scratch);
+  // The sigmas to report: with the consider terms of the held states.
+  const Mat21& P = filter_.reported_covariance(i);
   TrajectoryRecord r;
   r.t = ekf.state().t;
   const ReferencePointModel m = reference_point_model(s.reference_point_input());

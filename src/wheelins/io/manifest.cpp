@@ -177,7 +177,7 @@ class Loader : public YamlReader {
 
  private:
   ModuleSpec module(const YAML::Node& n, const std::string& path) const;
-  void noise(const YAML::Node& n, const std::string& path, ImuNoise& out) const;
+  void noise(const YAML::Node& n, const std::string& path, ModuleSpec& out) const;
 
   fs::path file_;
 };
@@ -343,19 +343,26 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
     s.accel_range = number(v, p);
     range(s.accel_range, 5.0, 1e5, p, v, "m/s^2 (the accelerometer's full scale)");
   }
-  if (auto v = get(n, "noise"); v.IsDefined()) noise(v, join(path, "noise"), s.noise);
+  // Defaults for what the manifest does not state: ImuNoise's, and a velocity random walk
+  // by kind (a rolling wheel vibrates).
+  s.noise_stated = 0;
+  s.noise.acc_vrw = s.kind == ModuleKind::kWheel ? kDefaultWheelVrw : kDefaultBodyVrw;
+  if (auto v = get(n, "noise"); v.IsDefined()) noise(v, join(path, "noise"), s);
   return s;
 }
 
-void Loader::noise(const YAML::Node& n, const std::string& path, ImuNoise& out) const {
+void Loader::noise(const YAML::Node& n, const std::string& path, ModuleSpec& out) const {
   require_map(n, path);
   check_keys(n, path, noise_key_names());
+  std::uint16_t bit = 1;
   for (const auto& k : kNoiseKeys) {
     if (auto v = get(n, k.key); v.IsDefined()) {
       const std::string p = join(path, k.key);
       range(number(v, p), k.lo, k.hi, p, v, k.unit_name);
-      out.*k.member = number(v, p, k.unit);
+      out.noise.*k.member = number(v, p, k.unit);
+      out.noise_stated |= bit;
     }
+    bit = static_cast<std::uint16_t>(bit << 1);
   }
 }
 
@@ -522,9 +529,15 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
     if (s.accel_range > 0.0)
       w.line(4, "accel_range_m_s2: " + num(s.accel_range), p + "accel_range_m_s2",
              "full scale: readings beyond it are faults");
-    w.line(4, "noise:", p + "noise");
-    for (const auto& k : kNoiseKeys)
-      w.line(6, std::string(k.key) + ": " + num(s.noise.*k.member, k.unit), p + "noise." + k.key);
+    if (s.noise_stated) {
+      w.line(4, "noise:", p + "noise");
+      std::uint16_t bit = 1;
+      for (const auto& k : kNoiseKeys) {
+        if (s.noise_stated & bit)
+          w.line(6, std::string(k.key) + ": " + num(s.noise.*k.member, k.unit), p + "noise." + k.key);
+        bit = static_cast<std::uint16_t>(bit << 1);
+      }
+    }
   }
   return w.str();
 }

@@ -6,6 +6,7 @@
 // save_manifest() writes human units back. See docs/manifest.md.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -23,7 +24,24 @@ enum class FileLayout { kBinary, kText };       ///< float64 LE rows, or whitesp
 
 /// One IMU module (one chip's data file): the module as the estimator knows it (name, kind,
 /// rate, geometry, noise: ImuModule, nav/vehicle.hpp) and where and how its data are stored.
+/// Which of ImuNoise's figures a manifest states, one bit per key of its `noise:` map in the
+/// order of docs/manifest.md (gyro_arw, acc_vrw, gyro_bias, acc_bias, gyro_sf, acc_sf, the four
+/// correlation times).
+constexpr std::uint16_t kAllNoiseStated = 0x3FF;
+enum NoiseKeyBit : std::uint16_t { kNoiseArw = 1, kNoiseVrw = 2, kNoiseGyroBias = 4, kNoiseAccBias = 8,
+                                   kNoiseGyroSf = 16, kNoiseAccSf = 32 };
+
+/// The velocity random walk a module is given when its manifest does not state one: a wheel
+/// vibrates as it rolls (the noise identification starts from this and the data correct it,
+/// docs/filter.md section 13; a figure too small makes the velocity updates push the sensor
+/// errors away, one too large only slows the filter a little) [m/s/sqrt(s)].
+constexpr double kDefaultWheelVrw = 3.0 / 60.0;
+constexpr double kDefaultBodyVrw = 1.0 / 60.0;
+
 struct ModuleSpec : ImuModule {
+  /// The noise figures the manifest states (the others are defaults); save_manifest writes
+  /// only these.
+  std::uint16_t noise_stated = kAllNoiseStated;
   std::string group;           ///< physical module, e.g. "left-wheel" (its chips share it)
   std::string chip;            ///< e.g. "C1"
   std::filesystem::path file;  ///< absolute, or relative to the manifest's directory

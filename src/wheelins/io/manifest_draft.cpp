@@ -340,7 +340,9 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
       note[key + "position_v_m"] = std::string(kTodo) + " (IMU centre in the v-frame)";
       note[key + "mounting_deg"] = std::string(kTodo) + " (C_b^v as roll, pitch, yaw)";
     }
-    note[key + "noise"] = "generic MEMS defaults; use your IMU's figures";
+    // No noise figures: wheelins identifies them from the data (docs/filter.md section 13);
+    // a user who knows the IMUs' figures may state them as priors (docs/manifest.md).
+    s.noise_stated = 0;
     m.modules.push_back(s);
   }
   d.facts.push_back(d.layout + " layout: " + std::to_string(m.modules.size()) + " IMU module(s) in " + quote(dir_in));
@@ -431,10 +433,11 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
     d.todo.insert(d.todo.begin() + (any_wheel ? 1 : 0),
                   "body modules: position_v_m and mounting_deg (C_b^v; zero written)");
   if (any_left && any_right) d.todo.push_back("vehicle.track_m (0.33 written)");
-  d.todo.push_back("noise: generic MEMS defaults written; replace them by your IMUs' figures");
 
   d.notes.header = {"drafted by `wheelins manifest` from " + dir.string(),
-                    "values marked 'TODO' are guesses: measure them before trusting results"};
+                    "values marked 'TODO' are guesses: measure them before trusting results",
+                    "no noise figures: they are identified from the data (noise.yaml of a run); "
+                    "state your IMUs' figures under noise: to give priors (docs/manifest.md)"};
   return d;
 }
 

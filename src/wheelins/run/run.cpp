@@ -2,6 +2,8 @@
 // checks and merged, the navigator, the writers on a second thread, the staged outputs.
 #include "wheelins/run/run.hpp"
 
+#include "wheelins/run/noise_report.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -291,6 +293,7 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
   if (multi(r))
     for (const auto& m : r.modules) files.push_back(r.output_dir / (m + ".csv"));
   files.push_back(r.output_dir / "faults.csv");
+  files.push_back(r.output_dir / "noise.yaml");
   return files;
 }
 
@@ -454,6 +457,13 @@ RunResult run_navigation(const RunRequest& r) {
     AtomicTextFile report(staged(r.output_dir / "faults.csv"), false);
     report.write(csv);
     report.commit();
+  }
+  for (int i = 0; i < nav.subsystem_count(); ++i) result.noise.push_back(nav.noise_report(i));
+  result.noise_report = noise_report_text(result.noise, r.manifest, r.nav.noise.enabled);
+  if (out_dir) {
+    AtomicTextFile noise(staged(r.output_dir / "noise.yaml"), false);
+    noise.write(noise_report_yaml(result.noise, r.manifest, r.nav.noise.enabled));
+    noise.commit();
     out_dir->commit();  // every file appears at once
   }
   result.fault_report = fault_report_text(nav.faults());

@@ -37,6 +37,8 @@ struct RunResult {
   std::vector<std::filesystem::path> files;  ///< what was written
   std::string fault_report;                  ///< readable summary of the fault handling
   std::vector<FaultEvent> fault_events;      ///< every detection and what was done
+  std::vector<ModuleNoiseReport> noise;      ///< the noise model per module (noise.yaml)
+  std::string noise_report;                  ///< readable summary of it, with the warnings
 };
 
 /// Runs the request. The output directory is written through OutputDir: checked, locked

@@ -27,7 +27,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   const YamlReader y(file, warn, "run configuration");
   const YAML::Node& root = y.root();
   y.check_keys(root, "", {"dataset", "configuration", "chips", "modules", "output", "duration_s",
-                          "filter", "fusion", "faults"});
+                          "filter", "fusion", "faults", "noise"});
   RunConfig c;
   const fs::path base = file.parent_path();
   auto rel = [&](const std::string& p) { return fs::path(p).is_absolute() ? fs::path(p) : base / p; };
@@ -71,7 +71,14 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     y.check_keys(f, "filter",
                  {"mechanization", "earth_rotation", "velocity_update_hz", "speed_window_s",
                   "wheel_velocity_std_m_s", "body_velocity_std_m_s", "velocity_gate",
-                  "initial_std", "covariance_interval_s"});
+                  "initial_std", "covariance_interval_s", "estimate_yaw_scale_factors",
+                  "estimate_axle_accel_scale_factors"});
+    if (auto v = y.get(f, "estimate_axle_accel_scale_factors"); v.IsDefined())
+      c.nav.wheel.estimate_axle_accel_scale_factor =
+          y.boolean(v, "filter.estimate_axle_accel_scale_factors");
+    if (auto v = y.get(f, "estimate_yaw_scale_factors"); v.IsDefined())
+      c.nav.wheel.estimate_yaw_scale_factor = c.nav.body.estimate_yaw_scale_factor =
+          y.boolean(v, "filter.estimate_yaw_scale_factors");
     if (auto v = y.get(f, "mechanization"); v.IsDefined())
       c.nav.mechanization = y.choice<MechanizationOptions::Method>(
           v, "filter.mechanization",
@@ -160,6 +167,27 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
                  &v);
     }
     if (auto v = y.get(f, "centralized"); v.IsDefined()) o.centralized = y.boolean(v, "fusion.centralized");
+  }
+
+  if (auto f = y.get(root, "noise"); f.IsDefined()) {
+    // The noise identification (docs/filter.md section 13, docs/run-config.md).
+    y.require_map(f, "noise");
+    y.check_keys(f, "noise", {"adapt", "window_updates", "min_velocity_std_fraction", "max_vrw_m_s_sqrt_h",
+                              "min_speed_m_s", "settle_s", "min_gyro_bias_deg_h"});
+    NoiseAdaptationOptions& o = c.nav.noise;
+    if (auto v = y.get(f, "adapt"); v.IsDefined()) o.enabled = y.boolean(v, "noise.adapt");
+    if (auto v = y.get(f, "window_updates"); v.IsDefined())
+      o.window = y.number_in(v, "noise.window_updates", 5.0, 1e5, "velocity updates");
+    if (auto v = y.get(f, "min_velocity_std_fraction"); v.IsDefined())
+      o.r_floor_fraction = y.number_in(v, "noise.min_velocity_std_fraction", 0.01, 1.0, "(of the given sigma)");
+    if (auto v = y.get(f, "max_vrw_m_s_sqrt_h"); v.IsDefined())
+      o.vrw_max = y.number_in(v, "noise.max_vrw_m_s_sqrt_h", 0.01, 1000.0, "m/s/sqrt(h)") / 60.0;
+    if (auto v = y.get(f, "min_speed_m_s"); v.IsDefined())
+      o.min_speed = y.number_in(v, "noise.min_speed_m_s", 0.0, 100.0, "m/s");
+    if (auto v = y.get(f, "settle_s"); v.IsDefined())
+      o.settle = y.number_in(v, "noise.settle_s", 0.0, 3600.0, "s");
+    if (auto v = y.get(f, "min_gyro_bias_deg_h"); v.IsDefined())
+      o.bias_floor = y.number_in(v, "noise.min_gyro_bias_deg_h", 0.0, 1e4, "deg/h") * kDeg / 3600.0;
   }
 
   if (auto f = y.get(root, "faults"); f.IsDefined()) {
