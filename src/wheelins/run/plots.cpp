@@ -496,9 +496,15 @@ std::vector<fs::path> write_experiment_plots(const ExperimentResult& r, const Tr
   if (warn)
     for (const auto& n : out.notes) warn(n);
   if (!options.render || out.plots.empty()) return written;
+  for (auto& f : render_gnuplot(plots, out.plots, warn, options)) written.push_back(std::move(f));
+  return written;
+}
 
+std::vector<fs::path> render_gnuplot(const fs::path& plots, const std::vector<std::string>& names,
+                                     const WarningSink& warn, const PlotOptions& options) {
+  std::vector<fs::path> written;
   const fs::path abs_plots = fs::absolute(plots);
-  for (const auto& name : out.plots) {
+  for (const auto& name : names) {
     const fs::path png = abs_plots / (name + ".png");
     const fs::path partial = abs_plots / (name + ".png.partial");
     const ProgramResult pr = run_program(

@@ -54,4 +54,12 @@ std::vector<std::filesystem::path> write_experiment_plots(const ExperimentResult
                                                           bool overwrite, const WarningSink& warn,
                                                           const PlotOptions& options = {});
 
+/// Runs gnuplot on `dir/NAME.gp` for each name (in `dir`, so the scripts' relative data paths
+/// work), each writing `dir/NAME.png` through `NAME.png.partial`. Returns the PNGs made;
+/// gnuplot missing (one warning, with the command to draw them later) or failing on a script
+/// is reported through `warn`.
+std::vector<std::filesystem::path> render_gnuplot(const std::filesystem::path& dir,
+                                                  const std::vector<std::string>& names,
+                                                  const WarningSink& warn, const PlotOptions& options = {});
+
 }  // namespace wheelins::eval
