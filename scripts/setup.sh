@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages wheelins needs, only those that are missing.
 # Idempotent: when everything is present it only checks and returns.
-# gnuplot-nox draws the plots of `wheelins experiment` (optional at run time).
+# gnuplot-nox draws the plots of `wheelins experiment` and `wheelins study report` (optional at
+# run time); parallel (GNU parallel) runs a study's jobs in scripts/study-parallel.sh.
 # Optional groups, named as arguments: `fuzz` (clang and its libFuzzer/sanitizer
 # runtime, for scripts/fuzz.sh).
 # Usage: scripts/setup.sh [fuzz]
@@ -11,7 +12,7 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  gnuplot-nox
+  gnuplot-nox parallel
 )
 for group in "$@"; do
   case $group in

@@ -1,0 +1,45 @@
+// Files that several processes (on several machines, over a shared directory) write at
+// once: every result appears complete or not at all, and one process at a time makes a
+// dataset.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <string_view>
+
+namespace wheelins::study {
+
+/// Writes the bytes of one chunk to `fd` (the temporary file); throws on failure.
+using ChunkWriter = std::function<void(int fd, std::string_view chunk)>;
+
+/// Writes `text` to `file` through a temporary file of a unique name in the same directory
+/// (`.NAME.tmp-HOST-PID-N`), flushed to disk (fsync) and renamed over `file`: a process
+/// killed or failing part-way leaves no `file`, or the old one. The temporary file is
+/// removed on failure. `write_chunk` (tests) replaces the write of each 64 KiB chunk.
+void write_file_atomic(const std::filesystem::path& file, std::string_view text,
+                       const ChunkWriter& write_chunk = {});
+
+/// The whole file; nullopt-like empty string and false when it cannot be read.
+bool read_file(const std::filesystem::path& file, std::string& out);
+
+/// A unique suffix for temporary names: host, process id and a counter.
+std::string unique_suffix();
+
+/// An exclusive advisory lock (flock) on `file` (created if missing), held until
+/// destruction; waits for other holders. Where the file system has no locks (some network
+/// file systems) locked() is false and the caller relies on atomic renames alone.
+class FileLock {
+ public:
+  explicit FileLock(const std::filesystem::path& file);
+  ~FileLock();
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+  bool locked() const { return locked_; }
+
+ private:
+  int fd_ = -1;
+  bool locked_ = false;
+};
+
+}  // namespace wheelins::study

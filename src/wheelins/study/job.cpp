@@ -1,0 +1,645 @@
+// Running a study's jobs (job.hpp): one job's dataset, run and evaluation written as its
+// result or failure record, the job states, every job not done on all cores, and the
+// results read back.
+#include "wheelins/study/job.hpp"
+
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <ostream>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/truth.hpp"
+#include "wheelins/nav/types.hpp"
+#include "wheelins/run/run.hpp"
+#include "wheelins/run/run_config.hpp"
+#include "wheelins/study/dataset.hpp"
+#include "wheelins/study/json.hpp"
+
+namespace wheelins::study {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kResultFormat = "wheelins-study-job-1";
+constexpr const char* kDoneTail = "\"status\": \"done\"\n}\n";
+
+double unix_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+double since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+std::string host_name() {
+  char host[256] = "";
+  if (::gethostname(host, sizeof host - 1) != 0) return "?";
+  host[sizeof host - 1] = '\0';
+  return host;
+}
+
+fs::path result_file(const Study& s, std::size_t k) {
+  return s.jobs_dir() / (std::to_string(k) + ".json");
+}
+fs::path failure_file(const Study& s, std::size_t k) {
+  return s.jobs_dir() / (std::to_string(k) + ".failed.json");
+}
+fs::path side_file(const Study& s, std::size_t k, const char* what) {
+  return s.jobs_dir() / (std::to_string(k) + "." + what + ".csv");
+}
+
+/// The "key" of a job file, read from its text ("" if none).
+std::string key_in(const std::string& text) {
+  const std::string tag = "\"key\": \"";
+  const auto p = text.find(tag);
+  if (p == std::string::npos) return "";
+  const auto e = text.find('"', p + tag.size());
+  return e == std::string::npos ? "" : text.substr(p + tag.size(), e - p - tag.size());
+}
+
+std::string fmt(double v, int decimals) {
+  if (!std::isfinite(v)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+void write_labels(JsonWriter& w, const Study& s, const Job& j) {
+  w.begin_object("labels");
+  for (std::size_t i = 0; i < j.labels.size(); ++i) w.str(s.axes()[i].name.c_str(), j.labels[i]);
+  w.end_object();
+}
+
+/// Moves a result of other settings to jobs/stale/ (never deletes a result).
+void move_stale(const Study& s, const Job& j) {
+  const fs::path file = result_file(s, j.index);
+  std::string text;
+  if (!read_file(file, text)) return;
+  const std::string old = key_in(text);
+  if (old == j.key) return;
+  std::error_code ec;
+  const fs::path dir = s.jobs_dir() / "stale";
+  fs::create_directories(dir, ec);
+  fs::path target =
+      dir / (std::to_string(j.index) + "-" + (old.empty() ? "unknown" : old) + ".json");
+  for (int n = 2; fs::exists(target, ec); ++n)
+    target = dir / (std::to_string(j.index) + "-" + old + "-" + std::to_string(n) + ".json");
+  fs::rename(file, target, ec);
+  if (ec && fs::exists(file))
+    throw InputError("'" + file.string() +
+                     "': holds a result of other settings and cannot be moved to '" +
+                     target.string() + "': " + ec.message());
+}
+
+std::string series_csv(const std::vector<eval::EpochError>& series) {
+  std::string s =
+      "t_s,distance_m,err_n_m,err_e_m,err_d_m,err_h_m,heading_err_rad,sigma_h_m,nees_h\n";
+  for (const auto& e : series) {
+    const double v[9] = {e.t,     e.distance,    e.err_ned.x(), e.err_ned.y(), e.err_ned.z(),
+                         e.err_h, e.heading_err, e.sigma_h,     e.nees_h};
+    for (int k = 0; k < 9; ++k) {
+      if (k) s += ',';
+      append_double(s, v[k]);
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+std::string track_csv(const std::vector<TrajectoryRecord>& track) {
+  std::string s = "t_s,lat_rad,lon_rad,h_m\n";
+  for (const auto& r : track) {
+    const double v[4] = {r.t, r.lla.lat, r.lla.lon, r.lla.h};
+    for (int k = 0; k < 4; ++k) {
+      if (k) s += ',';
+      append_double(s, v[k]);
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+/// Rows of numbers of a side file (header skipped); empty on any problem.
+std::vector<std::vector<double>> read_rows(const fs::path& file, std::size_t columns) {
+  std::vector<std::vector<double>> rows;
+  std::string text;
+  if (!read_file(file, text)) return {};
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    const char* p = line.c_str();
+    while (*p) {
+      char* end = nullptr;
+      row.push_back(std::strtod(p, &end));
+      if (end == p) return {};
+      p = *end == ',' ? end + 1 : end;
+    }
+    if (row.size() != columns) return {};
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+}  // namespace
+
+const char* job_state_name(JobState s) {
+  switch (s) {
+    case JobState::kDone:
+      return "done";
+    case JobState::kFailed:
+      return "failed";
+    case JobState::kStale:
+      return "stale";
+    case JobState::kUnreadable:
+      return "unreadable";
+    default:
+      return "missing";
+  }
+}
+
+JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
+  JobOutcome out;
+  JobTiming& tm = out.timing;
+  tm.started = unix_now();
+  tm.host = host_name();
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string K = std::to_string(j.index);
+  const std::string who = "job " + K;
+  std::error_code ec;
+  fs::create_directories(s.jobs_dir(), ec);
+  if (ec) throw InputError("'" + s.jobs_dir().string() + "': cannot create: " + ec.message());
+  move_stale(s, j);
+
+  std::vector<std::string> warnings;
+  std::string result;
+  std::vector<std::pair<fs::path, std::string>> side;
+  try {
+    auto t = std::chrono::steady_clock::now();
+    const PreparedDataset data = prepare_dataset(j.dataset, s.cache_dir());
+    tm.dataset = since(t);
+    tm.generated = data.generated;
+    t = std::chrono::steady_clock::now();
+
+    const std::string where = "'" + s.file().string() + "': run settings of " + who;
+    const RunConfig cfg = load_run_yaml(j.run_yaml, data.manifest, where);
+    const WarningSink collect = [&](const std::string& m) {
+      warnings.push_back(m);
+      if (o.warn) o.warn(who + ": " + m);
+    };
+    // An edited manifest must read without warnings: a misspelt key would be ignored.
+    const WarningSink manifest_warn =
+        j.dataset.manifest_edits.empty() ? collect : WarningSink([&](const std::string& m) {
+          throw InputError(m + " (after the study's manifest edits)");
+        });
+    RunRequest req = make_run_request(cfg, manifest_warn);
+    req.output_dir.clear();
+    req.progress = o.progress;
+    req.warn = collect;
+    if (!req.manifest.truth_file)
+      throw InputError("'" + req.manifest.path.string() +
+                       "': no truth file (key `truth`): a study evaluates every run against it");
+    TruthReader truth(req.manifest.resolve(*req.manifest.truth_file));
+    eval::Evaluator::Sources src;
+    src.truth_file = truth.file().string();
+    src.traj_file = "the vehicle solution of " + who;
+    src.traj_format = "memory";
+    src.truth_has_attitude = truth.has_velocity_attitude();
+    eval::Evaluator ev(earth::LocalFrame(req.manifest.origin), src, eval::EvalOptions{},
+                       j.keep_series);
+    TruthRecord next;
+    bool have = truth.next(next);
+    std::vector<TrajectoryRecord> track;
+    std::size_t records = 0;
+    // In step with the run: the truth records before each vehicle record go in first (as
+    // eval::evaluate() does), so memory stays flat however long the data.
+    req.on_record = [&](const TrajectoryRecord& r) {
+      while (have && next.t < r.t) {
+        ev.add_truth(next);
+        have = truth.next(next);
+      }
+      ev.add_trajectory(r);
+      if (j.keep_series && records % 20 == 0) track.push_back(r);  // 1 Hz of the 20 Hz records
+      ++records;
+    };
+    tm.setup = since(t);
+    t = std::chrono::steady_clock::now();
+    const RunResult rr = run_navigation(req);
+    tm.navigate = since(t);
+    tm.filter = rr.filter_seconds;
+    t = std::chrono::steady_clock::now();
+    ev.end_trajectory();
+    while (have) {
+      ev.add_truth(next);
+      have = truth.next(next);
+    }
+    eval::EvalResult e = ev.finish();
+    if (j.keep_series) {
+      std::vector<eval::EpochError> kept;  // 10 Hz of the 200 Hz truth epochs
+      for (std::size_t k = 0; k < e.series.size(); k += 20) kept.push_back(e.series[k]);
+      side.emplace_back(side_file(s, j.index, "series"), series_csv(kept));
+      side.emplace_back(side_file(s, j.index, "track"), track_csv(track));
+      e.series.clear();
+    }
+    out.summary = "drift " + fmt(100.0 * e.drift_rate, 3) + " %, heading " +
+                  fmt(e.heading_rmse / kDeg, 2) + " deg";
+
+    const NavigatorStats& st = rr.stats;
+    JsonWriter w;
+    w.begin_object();
+    w.str("format", kResultFormat);
+    w.integer("job", static_cast<std::int64_t>(j.index));
+    w.str("key", j.key);
+    w.str("study", s.name());
+    write_labels(w, s, j);
+    w.str("configuration", j.configuration);
+    w.begin_object("dataset")
+        .str("data", j.dataset.describe())
+        .str("manifest", data.manifest.string());
+    if (!j.dataset.cache_name.empty()) w.str("cache", j.dataset.cache_name);
+    w.end_object();
+    w.strings("modules", req.modules);
+    w.raw("evaluation", eval::to_json(e));
+    w.begin_object("stats")
+        .integer("samples", static_cast<std::int64_t>(st.samples))
+        .integer("epochs", static_cast<std::int64_t>(st.epochs))
+        .integer("records", static_cast<std::int64_t>(st.records))
+        .num("t_start_s", st.t_start)
+        .num("t_end_s", st.t_end)
+        .integer("velocity_updates", static_cast<std::int64_t>(st.velocity_updates))
+        .integer("velocity_rejected", static_cast<std::int64_t>(st.velocity_rejected))
+        .num("max_velocity_test_ratio", st.max_velocity_test_ratio)
+        .integer("position_updates", static_cast<std::int64_t>(st.position_updates))
+        .integer("position_rejected", static_cast<std::int64_t>(st.position_rejected))
+        .num("max_position_test_ratio", st.max_position_test_ratio)
+        .integer("velocity_steps", static_cast<std::int64_t>(st.velocity_steps))
+        .integer("position_steps", static_cast<std::int64_t>(st.position_steps))
+        .integer("covariance_checks", static_cast<std::int64_t>(st.covariance_checks))
+        .integer("covariance_not_pd", static_cast<std::int64_t>(st.covariance_not_pd))
+        .num("max_covariance_asymmetry", st.max_covariance_asymmetry)
+        .integer("fault_events", static_cast<std::int64_t>(rr.fault_events.size()))
+        .end_object();
+    w.str("fault_report", rr.fault_report);
+    w.strings("warnings", warnings);
+    w.str("run_config", "dataset: " + data.manifest.string() + "\n" + j.run_yaml);
+    w.str("canonical", j.canonical);
+    tm.finish = since(t);
+    tm.finished = unix_now();
+    w.begin_object("timing")
+        .num("total_s", since(t0))
+        .num("dataset_s", tm.dataset)
+        .boolean("dataset_generated", tm.generated)
+        .num("setup_s", tm.setup)
+        .num("navigate_s", tm.navigate)
+        .num("finish_s", tm.finish)
+        .num("filter_s", tm.filter)
+        .num("velocity_step_s", st.velocity_step_seconds)
+        .num("position_step_s", st.position_step_seconds)
+        .num("started_unix", tm.started)
+        .num("finished_unix", tm.finished)
+        .str("host", tm.host)
+        .end_object();
+    w.str("status", "done");
+    w.end_object();
+    result = w.text();
+
+    t = std::chrono::steady_clock::now();
+    for (const auto& [file, text] : side) write_file_atomic(file, text);
+    write_file_atomic(result_file(s, j.index), result, o.write_chunk);
+    tm.write = since(t);
+  } catch (const std::exception& e) {
+    out.error = e.what();
+    // A result of these settings from before (a rerun) is not this run's: leave none behind.
+    fs::remove(result_file(s, j.index), ec);
+    JsonWriter w;
+    w.begin_object();
+    w.str("format", "wheelins-study-failure-1");
+    w.integer("job", static_cast<std::int64_t>(j.index));
+    w.str("key", j.key);
+    w.str("study", s.name());
+    write_labels(w, s, j);
+    w.str("error", out.error);
+    w.strings("warnings", warnings);
+    w.str("canonical", j.canonical);
+    w.num("started_unix", tm.started);
+    w.num("failed_unix", unix_now());
+    w.str("host", tm.host);
+    w.str("status", "failed");
+    w.end_object();
+    write_file_atomic(failure_file(s, j.index), w.text());
+    return out;
+  }
+  fs::remove(failure_file(s, j.index), ec);
+  out.ok = true;
+  return out;
+}
+
+JobStatus job_status(const Study& s, const Job& j) {
+  JobStatus st;
+  std::string text;
+  if (read_file(result_file(s, j.index), text)) {
+    const std::string key = key_in(text);
+    if (!key.empty() && key != j.key) {
+      st.state = JobState::kStale;
+      st.detail = "jobs/" + std::to_string(j.index) +
+                  ".json holds a result of other settings (key " + key + ", the study now gives " +
+                  j.key + ")";
+      return st;
+    }
+    const std::string tail = kDoneTail;
+    if (key.empty() || text.size() < tail.size() ||
+        text.compare(text.size() - tail.size(), tail.size(), tail) != 0) {
+      st.state = JobState::kUnreadable;
+      st.detail = "jobs/" + std::to_string(j.index) + ".json is not a complete result";
+      return st;
+    }
+    st.state = JobState::kDone;
+    return st;
+  }
+  if (read_file(failure_file(s, j.index), text) && key_in(text) == j.key) {
+    st.state = JobState::kFailed;
+    try {
+      const YAML::Node n = YAML::Load(text);
+      st.detail = n["error"].as<std::string>();
+    } catch (const YAML::Exception&) {
+      st.detail = "(the failure record cannot be read)";
+    }
+  }
+  return st;
+}
+
+std::vector<std::size_t> parse_job_list(const std::string& text, std::size_t count) {
+  std::vector<std::size_t> out;
+  std::stringstream ss(text);
+  auto number = [&](const std::string& s) {
+    std::size_t used = 0;
+    unsigned long long v = 0;
+    try {
+      v = std::stoull(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (s.empty() || used != s.size() || s[0] == '-' || s[0] == '+')
+      throw InputError("--job '" + text + "': '" + s + "' is not a job number");
+    if (v >= count)
+      throw InputError("--job '" + text + "': job " + s +
+                       " does not exist (the study has jobs 0.." + std::to_string(count - 1) + ")");
+    return static_cast<std::size_t>(v);
+  };
+  for (std::string item; std::getline(ss, item, ',');) {
+    if (item.empty()) continue;
+    const auto dash = item.find('-', 1);
+    if (dash == std::string::npos) {
+      out.push_back(number(item));
+      continue;
+    }
+    const std::size_t a = number(item.substr(0, dash)), b = number(item.substr(dash + 1));
+    if (b < a) throw InputError("--job '" + text + "': the range " + item + " is empty");
+    for (std::size_t k = a; k <= b; ++k) out.push_back(k);
+  }
+  if (out.empty()) throw InputError("--job '" + text + "': no job given");
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const RunOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RunSummary sum;
+  std::vector<std::size_t> indices = given;
+  if (indices.empty())
+    for (std::size_t k = 0; k < s.job_count(); ++k) indices.push_back(k);
+  sum.requested = indices.size();
+  // Resolved on this thread (Study::job reads the study's YAML), then handed to workers.
+  std::vector<Job> pending;
+  std::set<std::string> checked;
+  for (std::size_t k : indices) {
+    Job j = s.job(k);
+    if (!o.rerun && job_status(s, j).state == JobState::kDone) {
+      ++sum.already_done;
+      continue;
+    }
+    if (checked.insert(j.run_yaml).second)
+      check_run_yaml(j.run_yaml, "'" + s.file().string() + "': run settings of job " +
+                                     std::to_string(k) + " (" + j.describe() + ")");
+    pending.push_back(std::move(j));
+  }
+  if (pending.empty()) {
+    sum.seconds = since(t0);
+    return sum;
+  }
+  std::error_code ec;
+  fs::create_directories(s.jobs_dir(), ec);
+  if (ec) throw InputError("'" + s.jobs_dir().string() + "': cannot create: " + ec.message());
+
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::atomic<std::size_t> next{0};
+  std::size_t finished = 0, running = 0;
+  std::exception_ptr fatal;
+  const bool tty = o.progress && ::isatty(STDERR_FILENO);
+  const std::size_t total = pending.size();
+  auto progress_line = [&]() {
+    const double el = since(t0);
+    std::string line = "\rstudy " + s.name() + ": " + std::to_string(finished) + "/" +
+                       std::to_string(total) + " jobs";
+    if (sum.already_done) line += " (+" + std::to_string(sum.already_done) + " done before)";
+    if (sum.failed) line += ", " + std::to_string(sum.failed) + " failed";
+    line += ", " + std::to_string(running) + " running, " + fmt(el, 0) + " s elapsed";
+    if (finished > 0 && finished < total)
+      line += ", ~" +
+              fmt(el * static_cast<double>(total - finished) / static_cast<double>(finished), 0) +
+              " s left";
+    std::fprintf(stderr, "%s   ", line.c_str());
+    std::fflush(stderr);
+  };
+  auto worker = [&]() {
+    for (std::size_t i = next++; i < total; i = next++) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (fatal) return;
+        ++running;
+      }
+      JobOutcome r;
+      try {
+        r = run_job(s, pending[i], o.job);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!fatal) fatal = std::current_exception();
+        --running;
+        cv.notify_all();
+        return;
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      --running;
+      ++finished;
+      const Job& j = pending[i];
+      std::string line = "[" + std::to_string(finished) + "/" + std::to_string(total) + "] job " +
+                         std::to_string(j.index) + " (" + j.describe() + "): ";
+      if (r.ok) {
+        ++sum.done;
+        line += r.summary + " (" + fmt(r.timing.finished - r.timing.started, 1) + " s" +
+                (r.timing.generated ? ", dataset simulated" : "") + ")";
+      } else {
+        ++sum.failed;
+        sum.failures.emplace_back(j.index, r.error);
+        line += "FAILED: " + r.error;
+      }
+      if (o.log && (!tty || !r.ok)) {
+        if (tty) std::fprintf(stderr, "\r%*s\r", 100, "");
+        *o.log << line << std::endl;
+      }
+      if (tty) progress_line();
+      cv.notify_all();
+    }
+  };
+  const int workers = std::max(1, std::min<int>(o.workers, static_cast<int>(total)));
+  std::vector<std::thread> threads;
+  for (int k = 0; k < workers; ++k) threads.emplace_back(worker);
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (finished < total && !(fatal && running == 0)) {
+      cv.wait_for(lock, std::chrono::seconds(1));
+      if (tty) progress_line();
+    }
+  }
+  for (auto& t : threads) t.join();
+  if (tty) std::fprintf(stderr, "\n");
+  if (fatal) std::rethrow_exception(fatal);
+  std::sort(sum.failures.begin(), sum.failures.end());
+  sum.seconds = since(t0);
+  return sum;
+}
+
+std::optional<JobRecord> read_job_record(const fs::path& file, std::string& error,
+                                         bool with_series) {
+  std::string text;
+  if (!read_file(file, text)) {
+    error = "cannot read '" + file.string() + "'";
+    return std::nullopt;
+  }
+  const std::string tail = kDoneTail;
+  if (text.size() < tail.size() ||
+      text.compare(text.size() - tail.size(), tail.size(), tail) != 0) {
+    error = "'" + file.string() + "' is not a complete result";
+    return std::nullopt;
+  }
+  JobRecord r;
+  try {
+    const YAML::Node n = YAML::Load(text);
+    if (n["format"].as<std::string>() != kResultFormat) {
+      error = "'" + file.string() + "': not a study result (format " +
+              n["format"].as<std::string>() + ")";
+      return std::nullopt;
+    }
+    auto num = [](const YAML::Node& v) { return v && !v.IsNull() ? v.as<double>() : std::nan(""); };
+    auto count = [](const YAML::Node& v) { return v && !v.IsNull() ? v.as<std::uint64_t>() : 0; };
+    r.index = n["job"].as<std::size_t>();
+    r.key = n["key"].as<std::string>();
+    r.canonical = n["canonical"].as<std::string>();
+    r.configuration = n["configuration"].as<std::string>();
+    for (const auto& kv : n["labels"]) r.labels.push_back(kv.second.as<std::string>());
+    for (const auto& m : n["modules"]) r.modules.push_back(m.as<std::string>());
+    for (const auto& m : n["warnings"]) r.warnings.push_back(m.as<std::string>());
+    const YAML::Node e = n["evaluation"];
+    eval::EvalResult& ev = r.eval;
+    ev.truth_file = e["truth_file"].as<std::string>();
+    ev.traj_file = e["traj_file"].as<std::string>();
+    ev.traj_format = e["traj_format"].as<std::string>();
+    ev.truth_records = count(e["truth_records"]);
+    ev.traj_records = count(e["traj_records"]);
+    ev.epochs = count(e["epochs"]);
+    ev.skipped_outside = count(e["skipped_outside"]);
+    ev.skipped_gap = count(e["skipped_gap"]);
+    ev.t_start = num(e["t_start_s"]);
+    ev.t_end = num(e["t_end_s"]);
+    ev.duration = num(e["duration_s"]);
+    ev.distance = num(e["distance_m"]);
+    ev.segment_length = num(e["segment_m"]);
+    ev.drift_rate = num(e["drift_rate_pct"]) / 100.0;
+    for (const auto& x : e["drift_curve_pct"]) ev.drift_curve.push_back(num(x) / 100.0);
+    ev.heading_rmse = num(e["heading_rmse_deg"]) * kDeg;
+    ev.heading_max_abs = num(e["heading_max_abs_deg"]) * kDeg;
+    ev.has_heading = std::isfinite(ev.heading_rmse);
+    ev.max_error = num(e["max_error_m"]);
+    ev.final_error = num(e["final_error_m"]);
+    ev.rms_error = num(e["rms_error_m"]);
+    ev.has_sigma = e["has_sigma"].as<bool>();
+    ev.sigma_epochs = count(e["sigma_epochs"]);
+    ev.within_3sigma = num(e["within_3sigma_fraction"]);
+    ev.mean_nees = num(e["mean_nees_h"]);
+    ev.aligned = e["aligned"].as<bool>();
+    ev.align_rotated = e["align_rotated"].as<bool>();
+    ev.align_yaw = num(e["align_yaw_deg"]) * kDeg;
+    for (int k = 0; k < 3; ++k) ev.align_offset[k] = num(e["align_offset_ned_m"][k]);
+    const YAML::Node st = n["stats"];
+    NavigatorStats& s = r.stats;
+    s.samples = count(st["samples"]);
+    s.epochs = count(st["epochs"]);
+    s.records = count(st["records"]);
+    s.t_start = num(st["t_start_s"]);
+    s.t_end = num(st["t_end_s"]);
+    s.velocity_updates = count(st["velocity_updates"]);
+    s.velocity_rejected = count(st["velocity_rejected"]);
+    s.max_velocity_test_ratio = num(st["max_velocity_test_ratio"]);
+    s.position_updates = count(st["position_updates"]);
+    s.position_rejected = count(st["position_rejected"]);
+    s.max_position_test_ratio = num(st["max_position_test_ratio"]);
+    s.velocity_steps = count(st["velocity_steps"]);
+    s.position_steps = count(st["position_steps"]);
+    s.covariance_checks = count(st["covariance_checks"]);
+    s.covariance_not_pd = count(st["covariance_not_pd"]);
+    s.max_covariance_asymmetry = num(st["max_covariance_asymmetry"]);
+    r.fault_events = count(st["fault_events"]);
+    const YAML::Node t = n["timing"];
+    s.velocity_step_seconds = num(t["velocity_step_s"]);
+    s.position_step_seconds = num(t["position_step_s"]);
+    r.timing.dataset = num(t["dataset_s"]);
+    r.timing.generated = t["dataset_generated"].as<bool>();
+    r.timing.setup = num(t["setup_s"]);
+    r.timing.navigate = num(t["navigate_s"]);
+    r.timing.finish = num(t["finish_s"]);
+    r.timing.filter = num(t["filter_s"]);
+    r.timing.started = num(t["started_unix"]);
+    r.timing.finished = num(t["finished_unix"]);
+    r.timing.host = t["host"].as<std::string>();
+  } catch (const YAML::Exception& ex) {
+    error = "'" + file.string() + "': cannot be read as a study result: " + ex.what();
+    return std::nullopt;
+  }
+  if (with_series) {
+    const fs::path dir = file.parent_path();
+    const std::string k = std::to_string(r.index);
+    for (const auto& row : read_rows(dir / (k + ".series.csv"), 9)) {
+      eval::EpochError e;
+      e.t = row[0];
+      e.distance = row[1];
+      e.err_ned = Vec3(row[2], row[3], row[4]);
+      e.err_h = row[5];
+      e.heading_err = row[6];
+      e.sigma_h = row[7];
+      e.nees_h = row[8];
+      r.series.push_back(e);
+    }
+    for (const auto& row : read_rows(dir / (k + ".track.csv"), 4)) {
+      TrajectoryRecord t;
+      t.t = row[0];
+      t.lla = {row[1], row[2], row[3]};
+      r.track.push_back(t);
+    }
+  }
+  return r;
+}
+
+}  // namespace wheelins::study
