@@ -1,16 +1,19 @@
 // `wheelins experiment`: every configuration and chip combination of the paper's
 // Section VI on one dataset; Tables 4-8 to the terminal, CSV/JSON/Markdown to files,
 // and the plots of Fig. 7-10 (data + gnuplot scripts, PNGs when gnuplot is installed).
+// It is a built-in study (docs/studies.md): OUT/study.yaml declares the runs and each run is
+// a job whose result lands in OUT/jobs/; --prepare writes only the study, so that a large
+// experiment shards (and resumes) like any study: `wheelins study run OUT/study.yaml`.
 #include <iostream>
 #include <sstream>
 
 #include "cli.hpp"
-#include "wheelins/run/experiment.hpp"
-#include "wheelins/run/plots.hpp"
-#include "wheelins/run/run_config.hpp"
-#include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/output_dir.hpp"
-#include "wheelins/io/truth.hpp"
+#include "wheelins/run/run_config.hpp"
+#include "wheelins/study/files.hpp"
+#include "wheelins/study/job.hpp"
+#include "wheelins/study/report.hpp"
+#include "wheelins/study/spec.hpp"
 
 namespace {
 using namespace wheelins;
@@ -26,13 +29,8 @@ struct Args {
   bool force = false;
   bool quiet = false;
   bool no_plots = false;
+  bool prepare = false;
 };
-
-void write_file(const fs::path& file, const std::string& text, bool overwrite) {
-  AtomicTextFile f(file, overwrite);
-  f.write(text);
-  f.commit();
-}
 
 int run(const Args& a) {
   fs::path manifest = a.dataset;
@@ -40,50 +38,81 @@ int run(const Args& a) {
   const fs::path final_out = a.out.empty() ? manifest.parent_path() / "experiment" : fs::path(a.out);
   if (!(a.duration >= 0.0 && a.duration <= 1e7))
     throw InputError("--duration " + std::to_string(a.duration) + ": must be in (0, 1e7] s (0: all the data)");
+  speed_sharing_from_name(a.speed);  // checks the name
+
+  study::ExperimentSpec spec;
+  spec.dataset = fs::absolute(manifest).lexically_normal();
+  spec.speed = a.speed;
+  spec.duration = a.duration;
+  std::stringstream ss(a.only);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) spec.only.push_back(item);
+  const std::string text = study::experiment_study_yaml(spec);
+
+  if (a.prepare) {
+    // Only the study file: its jobs run with `wheelins study run` (sharded, resumable) and
+    // `wheelins study report` writes the tables into the same directory.
+    const fs::path study_file = final_out / "study.yaml";
+    std::string existing;
+    if (study::read_file(study_file, existing)) {
+      if (existing != text && !a.force)
+        throw InputError("'" + study_file.string() + "': holds the study of another experiment (other dataset "
+                         "or options); use --force to replace it, or choose another --out");
+    } else if (fs::exists(final_out) && !fs::is_empty(final_out)) {
+      throw InputError("'" + final_out.string() + "': is not empty; --prepare writes a study into an empty or new "
+                       "directory");
+    }
+    fs::create_directories(final_out);
+    if (existing != text) study::write_file_atomic(study_file, text);
+    const study::Study s = study::Study::load(study_file);
+    std::cout << "wrote " << study_file.string() << ": " << s.job_count() << " runs (jobs 0.." << s.job_count() - 1
+              << "); run them with `wheelins study run " << study_file.string()
+              << "` (all cores, resumable), scripts/study-parallel.sh or scripts/study.sbatch, then: "
+                 "wheelins study report "
+              << study_file.string() << "\n";
+    return 0;
+  }
+
   // Checked, locked and staged before the runs: a refusal or an unwritable place costs
-  // nothing, and the tables and plots appear together at the end (io/output_dir.hpp).
+  // nothing, and the study, its jobs' results, the tables and the plots appear together at
+  // the end (io/output_dir.hpp).
   OutputDirOptions out_opt;
   out_opt.overwrite = a.force;
   out_opt.kind = "experiment";
   out_opt.inputs.push_back(manifest);
   OutputDir out_dir(final_out, out_opt);
   const fs::path out = out_dir.staging();
-  const std::vector<fs::path> files{out / "experiment.md", out / "runs.csv", out / "experiment.json"};
+  study::write_file_atomic(out / "study.yaml", text);
+  const study::Study s = study::Study::load(out / "study.yaml");
 
-  eval::ExperimentOptions o;
-  o.nav.fusion.speed = speed_sharing_from_name(a.speed);
-  o.jobs = a.jobs;
-  o.duration = a.duration;
-  o.progress = !a.quiet;
-  o.warn = stderr_sink();
-  std::stringstream ss(a.only);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) o.only.push_back(item);
-
-  const eval::ExperimentResult r = eval::run_experiment(manifest, o);
-  const std::string md = eval::experiment_markdown(r);
-  fs::create_directories(out);
-  write_file(files[0], md, a.force);
-  write_file(files[1], eval::experiment_csv(r), a.force);
-  write_file(files[2], eval::experiment_json(r), a.force);
-  std::vector<fs::path> plots;
-  if (!a.no_plots) {
-    const TruthData truth = read_truth(r.truth_file);
-    plots = eval::write_experiment_plots(r, truth, earth::LocalFrame(r.origin), out, a.force, o.warn);
+  study::RunOptions ro;
+  ro.workers = a.jobs;
+  ro.progress = !a.quiet;
+  ro.job.warn = stderr_sink();
+  const study::RunSummary sum = study::run_jobs(s, {}, ro);
+  if (sum.failed) {
+    for (const auto& [k, e] : sum.failures) std::cerr << "error: run " << k << " failed: " << e << "\n";
+    throw InputError(std::to_string(sum.failed) + " of " + std::to_string(sum.requested) +
+                     " runs failed; nothing was written");
   }
+
+  study::ReportOptions rep;
+  rep.plots = !a.no_plots;
+  rep.warn = stderr_sink();
+  const study::Report r = study::write_report(s, rep);
   out_dir.commit();
-  std::cout << md;
+  std::cout << r.markdown;
   std::size_t events = 0, runs_with = 0;
-  for (const auto& x : r.runs) {
-    events += x.fault_events;
-    runs_with += x.fault_events > 0;
-  }
-  std::cout << "fault handling: " << events << " fault events in " << runs_with << " of "
-            << r.runs.size() << " runs (runs.csv, column fault_events)\n";
-  auto shown = [&](const fs::path& f) { return (final_out / f.lexically_relative(out)).string(); };
-  for (const auto& f : files) std::cout << "wrote " << shown(f) << "\n";
+  for (const auto& e : r.jobs)
+    if (e.record) {
+      events += e.record->fault_events;
+      runs_with += e.record->fault_events > 0;
+    }
+  std::cout << "fault handling: " << events << " fault events in " << runs_with << " of " << r.done
+            << " runs (runs.csv, column fault_events)\n";
+  auto shown = [&](const fs::path& f) { return (final_out / f.lexically_relative(s.results_dir())).string(); };
   std::size_t data_files = 0;
-  for (const auto& f : plots) {
+  for (const auto& f : r.files) {
     if (f.parent_path().filename() == "data") ++data_files;
     else std::cout << "wrote " << shown(f) << "\n";
   }
@@ -96,17 +125,25 @@ int run(const Args& a) {
 const bool registered = cli::register_command(
     40, "experiment", "Run the paper's experiment (Tables 4-8) on a dataset", [](CLI::App& sub) {
       auto a = std::make_shared<Args>();
-      sub.add_option("dataset", a->dataset, "Dataset directory (with manifest.yaml) or manifest file")
+      sub.add_option("dataset", a->dataset,
+                     "Dataset directory (with manifest.yaml) or manifest file")
           ->required();
       sub.add_option("--out,-o", a->out, "Output directory (default: DATASET/experiment)");
-      sub.add_option("--jobs,-j", a->jobs, "Runs in parallel (default 2)")->check(CLI::Range(1, 64));
+      sub.add_option("--jobs,-j", a->jobs, "Runs in parallel (default 2)")
+          ->check(CLI::Range(1, 64));
       sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
       sub.add_option("--only", a->only,
                      "Subset: single,dual-wheel,body-wheel,triple,centralized (comma list)");
       sub.add_option("--duration", a->duration, "Seconds of navigation per run (default: all)");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line");
-      sub.add_flag("--no-plots", a->no_plots, "Skip the plots (OUT/plots: data, gnuplot scripts, PNGs)");
+      sub.add_flag("--no-plots", a->no_plots,
+                   "Skip the plots (OUT/plots: data, gnuplot scripts, PNGs)");
+      sub.add_flag(
+          "--prepare", a->prepare,
+          "Only write OUT/study.yaml (the experiment as a study) to shard its runs over processes "
+          "or machines (docs/studies.md); `wheelins study report OUT/study.yaml` then writes the "
+          "tables");
       return [a]() { return run(*a); };
     });
 }  // namespace

@@ -534,6 +534,64 @@ TEST(StudyRun, SameReportHoweverTheJobsRan) {
       1);
 }
 
+TEST(StudyRun, ExperimentIsABuiltInStudy) {
+  ScratchDir d;
+  ASSERT_EQ(
+      shell(bin() + " simulate --out data --preset car --chips 2 --static 10 --duration 40 -q",
+            d.path())
+          .code,
+      0);
+  // One command, as before.
+  const Cmd one = shell(
+      bin() + " experiment data -o one --only single,triple,centralized --no-plots -q", d.path());
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_HAS(one.out, "## Table 4: single Wheel-INS");
+  EXPECT_TRUE(fs::exists(d / "one" / "study.yaml"));
+  // Sharded: the study file, jobs in reverse order, then the study's report.
+  const Cmd prep = shell(
+      bin() + " experiment data -o sharded --only single,triple,centralized --prepare", d.path());
+  ASSERT_EQ(prep.code, 0) << prep.err;
+  const Cmd count = shell(bin() + " study plan sharded/study.yaml --count", d.path());
+  const int n = std::stoi(count.out);
+  EXPECT_EQ(n, 4 + 4 + 4);  // 4 single, 4 triple, 4 centralized with two chips per module
+  for (int k = n - 1; k >= 0; --k)
+    ASSERT_EQ(
+        shell(bin() + " study run sharded/study.yaml -q --job " + std::to_string(k), d.path()).code,
+        0);
+  const Cmd rep = shell(bin() + " study report sharded/study.yaml --no-plots -q", d.path());
+  ASSERT_EQ(rep.code, 0) << rep.err;
+  // The tables but the timing (Table 8, the wall time) are the same.
+  auto tables = [](std::string md) {
+    md = md.substr(0, md.find("## Table 8"));
+    const auto a = md.find("runs in "), b = md.find(" s.", a);
+    return md.erase(a, b - a);
+  };
+  EXPECT_EQ(tables(slurp(d / "sharded" / "experiment.md")),
+            tables(slurp(d / "one" / "experiment.md")));
+  auto metrics = [](const std::string& csv) {  // runs.csv without the timing columns
+    std::string out;
+    std::istringstream in(csv);
+    for (std::string line; std::getline(in, line);) {
+      std::vector<std::string> f;
+      std::stringstream ls(line);
+      for (std::string x; std::getline(ls, x, ',');) f.push_back(x);
+      for (std::size_t i = 0; i < f.size(); ++i)
+        if (i < 12 || i == 16) out += f[i] + ",";
+      out += "\n";
+    }
+    return out;
+  };
+  EXPECT_EQ(metrics(slurp(d / "sharded" / "runs.csv")), metrics(slurp(d / "one" / "runs.csv")));
+  // Existing results are refused without --force, as before; another experiment's study too.
+  const Cmd again = shell(
+      bin() + " experiment data -o one --only single,triple,centralized --no-plots -q", d.path());
+  EXPECT_EQ(again.code, 2);
+  EXPECT_HAS(again.err, "already holds experiment");
+  const Cmd other = shell(bin() + " experiment data -o sharded --only single --prepare", d.path());
+  EXPECT_EQ(other.code, 2);
+  EXPECT_HAS(other.err, "holds the study of another experiment");
+}
+
 TEST(StudyRun, JobListParsing) {
   EXPECT_EQ(parse_job_list("3", 10), (std::vector<std::size_t>{3}));
   EXPECT_EQ(parse_job_list("7-9,1,8", 10), (std::vector<std::size_t>{1, 7, 8, 9}));

@@ -1,20 +1,11 @@
-// The paper's experiment (experiment.hpp): its run plan, the runs in parallel through
-// run_navigation() with a streaming evaluation, and Tables 4-8 as Markdown, CSV and JSON.
+// The paper's experiment (experiment.hpp): its run plan, and Tables 4-8 as Markdown, CSV
+// and JSON from the runs' results (the study engine runs them).
 #include "wheelins/run/experiment.hpp"
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <exception>
-#include <mutex>
 #include <sstream>
-#include <thread>
-
-#include "wheelins/run/run.hpp"
-#include "wheelins/io/truth.hpp"
-#include "wheelins/util/progress.hpp"
 
 namespace wheelins::eval {
 namespace fs = std::filesystem;
@@ -124,74 +115,6 @@ std::vector<ExperimentRun> experiment_plan(const Manifest& m, const ExperimentOp
     if (pick) pick->figure = true;
   }
   return plan;
-}
-
-ExperimentResult run_experiment(const fs::path& manifest_file, const ExperimentOptions& o) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  ExperimentResult res;
-  const Manifest m = load_manifest(manifest_file, o.warn);
-  if (!m.truth_file)
-    throw InputError("'" + manifest_file.string() + "': the experiment needs a truth file (key 'truth')");
-  const TruthData truth = read_truth(m.resolve(*m.truth_file));
-  const earth::LocalFrame frame(m.origin);
-  res.manifest = m.path;
-  res.dataset_name = m.name;
-  res.truth_file = truth.file;
-  res.origin = m.origin;
-  res.runs = experiment_plan(m, o);
-  if (res.runs.empty()) throw InputError("'" + manifest_file.string() + "': no run to make (no Wheel-IMU?)");
-
-  std::atomic<std::size_t> next{0}, done{0};
-  std::mutex mutex;
-  std::exception_ptr failure;
-  Progress progress("experiment (" + std::to_string(res.runs.size()) + " runs)", res.runs.size(),
-                    o.progress);
-  auto worker = [&]() {
-    for (std::size_t i = next++; i < res.runs.size(); i = next++) {
-      try {
-        ExperimentRun& run = res.runs[i];
-        RunRequest req;
-        req.manifest = m;
-        req.modules = run.modules;
-        req.nav = o.nav;
-        req.nav.earth_rotation = o.nav.earth_rotation && m.earth_rotation;
-        req.nav.fusion.centralized = run.centralized;
-        req.nav.output_interval = 0.05;  // 20 Hz is plenty for the metrics
-        req.progress = false;
-        req.max_duration = o.duration;
-        req.warn = o.warn;
-        TrajectoryData traj;
-        traj.has_ned = traj.has_lla = traj.has_heading = traj.has_pos_std = true;
-        req.on_record = [&](const TrajectoryRecord& r) { traj.records.push_back(r); };
-        const RunResult rr = run_navigation(req);
-        run.stats = rr.stats;
-        run.fault_events = rr.fault_events.size();
-        run.filter_seconds = rr.filter_seconds;
-        run.eval = evaluate(truth, traj, frame);
-        // Keep a 10 Hz error series for the figures only.
-        std::vector<EpochError> kept;
-        if (o.keep_series && run.figure)
-          for (std::size_t k = 0; k < run.eval.series.size(); k += 20) kept.push_back(run.eval.series[k]);
-        run.eval.series = std::move(kept);
-        if (o.keep_series && run.figure)
-          for (std::size_t k = 0; k < traj.records.size(); k += 20) run.track.push_back(traj.records[k]);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-      }
-      std::lock_guard<std::mutex> lock(mutex);
-      progress.update(++done);
-    }
-  };
-  const int jobs = std::max(1, std::min<int>(o.jobs, static_cast<int>(res.runs.size())));
-  std::vector<std::thread> threads;
-  for (int k = 1; k < jobs; ++k) threads.emplace_back(worker);
-  worker();
-  for (auto& t : threads) t.join();
-  progress.finish();
-  if (failure) std::rethrow_exception(failure);
-  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  return res;
 }
 
 std::string experiment_markdown(const ExperimentResult& r) {

@@ -6,8 +6,11 @@
 // body C(((i+j) mod 4) + 1)); and the first 8 Triple INS combinations again with the
 // centralized filter (Table 7/8).
 //
-// It drives its runs through the run driver (run/run.hpp) and evaluates them with eval/,
-// so it sits in the top layer; its names stay in namespace wheelins::eval.
+// The runs themselves are a built-in study (study/spec.hpp, the layer above):
+// `wheelins experiment` plans them here, runs them as study jobs and writes the tables and
+// plots from the jobs' results. The plan and the tables need the navigator's statistics
+// (fusion) and the metrics (eval), so they sit in the top layer run; their names stay in
+// namespace wheelins::eval.
 #pragma once
 
 #include <filesystem>
@@ -16,23 +19,14 @@
 
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/fusion/navigator.hpp"
-#include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/nav/earth.hpp"
 
 namespace wheelins::eval {
 
 struct ExperimentOptions {
-  // (the navigator options below include the fault handling; on by default)
-  NavigatorOptions nav;           ///< filter settings shared by every run
-  int jobs = 2;                   ///< runs in parallel
-  double duration = 0.0;          ///< navigation per run [s]; 0 = all data
-  bool progress = true;
   /// Configurations to run (single, dual-wheel, body-wheel, triple, centralized); empty = all.
   std::vector<std::string> only;
-  /// Keep the per-epoch error series of the figure runs (for plots).
-  bool keep_series = true;
-  WarningSink warn;
 };
 
 struct ExperimentRun {
@@ -61,8 +55,6 @@ struct ExperimentResult {
 /// The run list for a manifest (needs 4 chips per module group, or fewer: combinations
 /// shrink to what the manifest has).
 std::vector<ExperimentRun> experiment_plan(const Manifest& m, const ExperimentOptions& o);
-
-ExperimentResult run_experiment(const std::filesystem::path& manifest, const ExperimentOptions& o);
 
 /// Tables 4-8 in the paper's layout (Markdown), with a header naming the dataset.
 std::string experiment_markdown(const ExperimentResult& r);
