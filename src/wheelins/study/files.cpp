@@ -1,5 +1,5 @@
-// Files several processes write at once (files.hpp): results written through a temporary
-// file, fsync and rename, and the lock file one dataset generator holds.
+// Files several processes write at once (files.hpp): results written to a temporary file
+// renamed into place, and the lock file one dataset generator holds.
 #include "wheelins/study/files.hpp"
 
 #include <fcntl.h>
@@ -63,14 +63,6 @@ void write_file_atomic(const fs::path& file, std::string_view text,
     fs::remove(tmp, ec);
     throw;
   }
-  auto fail = [&](const std::string& what) {
-    ::close(fd);
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw InputError("'" + file.string() + "': " + what);
-  };
-  if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
-    fail(std::string("cannot flush to disk: ") + std::strerror(errno));
   if (::close(fd) != 0) {
     std::error_code ec;
     fs::remove(tmp, ec);

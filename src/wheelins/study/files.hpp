@@ -14,9 +14,11 @@ namespace wheelins::study {
 using ChunkWriter = std::function<void(int fd, std::string_view chunk)>;
 
 /// Writes `text` to `file` through a temporary file of a unique name in the same directory
-/// (`.NAME.tmp-HOST-PID-N`), flushed to disk (fsync) and renamed over `file`: a process
-/// killed or failing part-way leaves no `file`, or the old one. The temporary file is
-/// removed on failure. `write_chunk` (tests) replaces the write of each 64 KiB chunk.
+/// (`.NAME.tmp-HOST-PID-N`) renamed over `file`: a process killed or failing part-way leaves
+/// no `file`, or the old one. The temporary file is removed on failure. `write_chunk` (tests)
+/// replaces the write of each 64 KiB chunk. There is no fsync (it cost 8 ms a result here, more
+/// than the rest of a job's overhead): a machine that crashes may lose its latest results or
+/// leave one cut short, and the readers reject a result without its final line.
 void write_file_atomic(const std::filesystem::path& file, std::string_view text,
                        const ChunkWriter& write_chunk = {});
 
