@@ -44,8 +44,9 @@ const StudySetup& setup() {
     x->dir = fs::temp_directory_path() / ("wheelins-bench-study-" + std::to_string(::getpid()));
     fs::create_directories(x->dir);
     x->file = x->dir / "robot15.yaml";
-    std::ofstream(x->file) << "simulate: {preset: robot, profile: field, chips: 1, duration_s: 930}\n"
-                              "configurations: [single]\n";
+    std::ofstream(x->file)
+        << "simulate: {preset: robot, profile: field, chips: 1, duration_s: 930}\n"
+           "configurations: [single]\n";
     const study::Study st = study::Study::load(x->file);
     study::run_job(st, st.job(0));  // simulates the dataset into the cache
     return x;
@@ -77,10 +78,11 @@ void BM_StudyJob15MinRobot(benchmark::State& state) {
   const double n = static_cast<double>(state.iterations());
   state.counters["job_s"] = job / n;
   state.counters["navigate_s"] = navigate / n;
-  state.counters["load_ms"] = 1e3 * load / n;      // study file, job, state
-  state.counters["dataset_ms"] = 1e3 * data / n;   // the cache hit
-  state.counters["setup_ms"] = 1e3 * setup_s / n;  // run configuration, manifest, truth; result text
-  state.counters["write_ms"] = 1e3 * write / n;    // jobs/0.json (temporary file, fsync, rename)
+  state.counters["load_ms"] = 1e3 * load / n;     // study file, job, state
+  state.counters["dataset_ms"] = 1e3 * data / n;  // the cache hit
+  state.counters["setup_ms"] =
+      1e3 * setup_s / n;                         // run configuration, manifest, truth; result text
+  state.counters["write_ms"] = 1e3 * write / n;  // jobs/0.json (temporary file, fsync, rename)
   state.counters["overhead_ms"] = 1e3 * (job - navigate) / n;
   state.counters["overhead_pct"] = 100.0 * (job - navigate) / job;
 }
@@ -89,8 +91,9 @@ BENCHMARK(BM_StudyJob15MinRobot)->Unit(benchmark::kMillisecond)->UseRealTime()->
 void BM_StudyProcessStart(benchmark::State& state) {
   const StudySetup& s = setup();
   const std::string study = s.file.string();
-  std::vector<char*> argv{const_cast<char*>(WHEELINS_BINARY), const_cast<char*>("study"), const_cast<char*>("run"),
-                          const_cast<char*>(study.c_str()),   const_cast<char*>("--job"), const_cast<char*>("0"),
+  std::vector<char*> argv{const_cast<char*>(WHEELINS_BINARY), const_cast<char*>("study"),
+                          const_cast<char*>("run"),           const_cast<char*>(study.c_str()),
+                          const_cast<char*>("--job"),         const_cast<char*>("0"),
                           const_cast<char*>("--quiet"),       nullptr};
   for (auto _ : state) {
     pid_t pid = 0;

@@ -287,6 +287,38 @@ TEST(StudySpec, CanonicalTextIsTheSettingsNotTheirOrder) {
   EXPECT_NE(a.dataset.canonical.find("profile: datasheet"), std::string::npos);
 }
 
+TEST(StudySpec, ReferencesToTheDataSettings) {
+  ScratchDir d;
+  put(d / "s.yaml",
+      "simulate: {chips: 1, profile: field}\n"
+      "run: {filter.velocity_gate: \"${seed}*2\"}\n"
+      "sweep:\n"
+      "  simulate.wheel_noise: [0.5, 2]\n"
+      "  noise:\n"
+      "    none: {manifest.modules.*.noise: null}\n"
+      "    x3:\n"
+      "      manifest.modules.kind=wheel.noise.acc_vrw_m_s_sqrt_h: ${simulate.wheel_noise}*3\n"
+      "      manifest.modules.*.noise.gyro_sf_ppm: ${simulate.errors.gyro_sf_ppm}/3\n"
+      "seeds: [4]\n");
+  const Study s = Study::load(d / "s.yaml");
+  ASSERT_EQ(s.job_count(), 4u);
+  const Job j = s.job(3);  // wheel noise 2, x3
+  EXPECT_HAS(j.dataset.manifest_edits, "modules.kind=wheel.noise.acc_vrw_m_s_sqrt_h\": 6");
+  EXPECT_HAS(j.dataset.manifest_edits,
+             "modules.*.noise.gyro_sf_ppm\": 1000");  // the field profile's 3000 / 3
+  EXPECT_EQ(load_run_yaml(j.run_yaml, "/x/manifest.yaml", "t").nav.wheel.gate, 8.0);
+  EXPECT_EQ(s.job(0).dataset.canonical,
+            s.job(1).dataset.canonical);  // edits do not change the data
+  EXPECT_EQ(s.data_siblings(3), (std::vector<std::size_t>{2, 3}));
+  put(d / "bad.yaml",
+      "simulate: {chips: 1}\nmanifest:\n  modules.*.noise.gyro_sf_ppm: ${simulate.errors.nope}\n");
+  EXPECT_HAS(iotest::error_of([&] { Study::load(d / "bad.yaml").job(0); }),
+             "${simulate.errors.nope}: no such simulator setting");
+  put(d / "bad.yaml", "simulate: {chips: 1}\nrun:\n  filter.velocity_gate: x${seed}\n");
+  EXPECT_HAS(iotest::error_of([&] { Study::load(d / "bad.yaml").job(0); }),
+             "a reference is a whole value");
+}
+
 // --- Manifest edits and the dataset cache ----------------------------------------------
 
 TEST(StudyDataset, ManifestEdits) {
@@ -305,6 +337,10 @@ TEST(StudyDataset, ManifestEdits) {
   EXPECT_FALSE(one["modules"][1]["noise"]["acc_vrw_m_s_sqrt_h"]);
   EXPECT_EQ(one["truth"].as<std::string>(), "/data/GINS.bin");  // paths made absolute
   EXPECT_EQ(one["modules"][1]["file"].as<std::string>(), "/data/b.bin");
+  const YAML::Node wheels =
+      YAML::Load(edit_manifest(m, "- {modules.kind=wheel.noise.acc_vrw_m_s_sqrt_h: 2}\n", {}, "m"));
+  EXPECT_EQ(wheels["modules"][0]["noise"]["acc_vrw_m_s_sqrt_h"].as<double>(), 2.0);
+  EXPECT_FALSE(wheels["modules"][1]["noise"]["acc_vrw_m_s_sqrt_h"]);
   EXPECT_HAS(iotest::error_of(
                  [&] { edit_manifest(m, "- {modules.left-C9.noise.x: 1}\n", {}, "'m.yaml'"); }),
              "manifest.modules.left-C9.noise.x matches nothing");
@@ -590,6 +626,21 @@ TEST(StudyRun, ExperimentIsABuiltInStudy) {
   const Cmd other = shell(bin() + " experiment data -o sharded --only single --prepare", d.path());
   EXPECT_EQ(other.code, 2);
   EXPECT_HAS(other.err, "holds the study of another experiment");
+}
+
+TEST(StudyRun, DatasetsDeletedWhenEveryJobOnThemIsDone) {
+  ScratchDir d;
+  put(d / "s.yaml",
+      "keep_datasets: false\nsimulate: {preset: car, chips: 1, static_s: 5, duration_s: 12}\n"
+      "seeds: [1, 2]\nconfigurations: [single, triple]\n");
+  const Study s = Study::load(d / "s.yaml");
+  const fs::path seed1 = s.cache_dir() / s.job(0).dataset.cache_name;
+  ASSERT_EQ(shell(bin() + " study run s.yaml --job 0 -q", d.path()).code, 0);
+  EXPECT_TRUE(fs::exists(seed1));  // job 1 still needs it
+  ASSERT_EQ(shell(bin() + " study run s.yaml -q --no-report", d.path()).code, 0);
+  EXPECT_FALSE(fs::exists(seed1));
+  EXPECT_FALSE(fs::exists(s.cache_dir() / s.job(2).dataset.cache_name));
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(job_status(s, s.job(k)).state, JobState::kDone);
 }
 
 TEST(StudyRun, JobListParsing) {

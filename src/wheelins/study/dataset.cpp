@@ -43,9 +43,13 @@ void apply_edit(YAML::Node node, const std::vector<std::string>& parts, std::siz
   if (node.IsSequence()) {
     for (std::size_t k = 0; k < node.size(); ++k) {
       YAML::Node el = node[k];
+      // By position, by name, or by a field's value (kind=wheel).
+      const auto eq = part.find('=');
+      const std::string field = eq == std::string::npos ? "name" : part.substr(0, eq);
+      const std::string want = eq == std::string::npos ? part : part.substr(eq + 1);
       const bool hit =
           part == "*" || (whole_number(part) && std::stoul(part) == k) ||
-          (el.IsMap() && el["name"] && el["name"].IsScalar() && el["name"].Scalar() == part);
+          (el.IsMap() && el[field] && el[field].IsScalar() && el[field].Scalar() == want);
       if (!hit) continue;
       if (last) {
         if (value.IsNull()) continue;  // removing list elements is not an edit we offer

@@ -27,8 +27,9 @@ struct PreparedDataset {
 PreparedDataset prepare_dataset(const DatasetSpec& d, const std::filesystem::path& cache_dir);
 
 /// Applies manifest edits (the YAML list of `DOTTED.KEY: value` of DatasetSpec) to the text
-/// of a manifest: `*` matches every element of a list or key of a map, a module is also
-/// matched by its name (modules.left-C1.noise), and null removes a key. Relative file paths
+/// of a manifest: `*` matches every element of a list or key of a map, a list element is also
+/// matched by its position, its name (modules.left-C1.noise) or a field's value
+/// (modules.kind=wheel.noise), and null removes a key. Relative file paths
 /// are made absolute against `base_dir` when it is given. Returns the new YAML text.
 std::string edit_manifest(const std::string& manifest_text, const std::string& edits,
                           const std::filesystem::path& base_dir, const std::string& where);

@@ -154,6 +154,25 @@ std::vector<std::vector<double>> read_rows(const fs::path& file, std::size_t col
 
 }  // namespace
 
+bool delete_dataset_when_done(const Study& s, const Job& j) {
+  // Every job on these data done.
+  std::vector<Job> siblings;
+  for (std::size_t k : s.data_siblings(j.index)) {
+    if (k == j.index) continue;
+    Job other = s.job(k);
+    if (other.dataset.cache_name != j.dataset.cache_name) continue;
+    if (job_status(s, other).state != JobState::kDone) return false;
+    siblings.push_back(std::move(other));
+  }
+  const fs::path dir = s.cache_dir() / j.dataset.cache_name;
+  const FileLock lock(s.cache_dir() / (j.dataset.cache_name + ".lock"));
+  for (const auto& o : siblings)  // again under the lock: a rerun may have started
+    if (job_status(s, o).state != JobState::kDone) return false;
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  return !ec;
+}
+
 const char* job_state_name(JobState s) {
   switch (s) {
     case JobState::kDone:
@@ -181,6 +200,8 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
   fs::create_directories(s.jobs_dir(), ec);
   if (ec) throw InputError("'" + s.jobs_dir().string() + "': cannot create: " + ec.message());
   move_stale(s, j);
+  // A result of these settings is being replaced (a rerun): it no longer counts as done.
+  fs::remove(result_file(s, j.index), ec);
 
   std::vector<std::string> warnings;
   std::string result;
@@ -342,6 +363,7 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
   }
   fs::remove(failure_file(s, j.index), ec);
   out.ok = true;
+  if (!s.keep_datasets() && j.dataset.sim) delete_dataset_when_done(s, j);
   return out;
 }
 
@@ -421,7 +443,7 @@ RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const
   if (indices.empty())
     for (std::size_t k = 0; k < s.job_count(); ++k) indices.push_back(k);
   sum.requested = indices.size();
-  // Resolved on this thread (Study::job reads the study's YAML), then handed to workers.
+  // Resolved before the workers start: a bad setting stops the run before any job.
   std::vector<Job> pending;
   std::set<std::string> checked;
   for (std::size_t k : indices) {

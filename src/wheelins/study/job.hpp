@@ -52,6 +52,10 @@ struct JobOptions {
 /// job itself (returned, and written as K.failed.json); throws if not even that can be written.
 JobOutcome run_job(const Study& study, const Job& job, const JobOptions& options = {});
 
+/// With `keep_datasets: false`: deletes job j's simulated dataset if every job on it is done
+/// (run_job calls it after a success). Returns whether it deleted it.
+bool delete_dataset_when_done(const Study& study, const Job& job);
+
 enum class JobState { kMissing, kDone, kFailed, kStale, kUnreadable };
 const char* job_state_name(JobState s);
 

@@ -10,7 +10,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -186,6 +188,52 @@ std::string slug(std::string s) {
   for (char& c : s)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
   return s;
+}
+
+/// The `wheelins simulate` option names that stand for a scenario.yaml key.
+const std::map<std::string, std::string>& sim_alias() {
+  static const std::map<std::string, std::string> a = {{"preset", "vehicle.preset"},
+                                                       {"terrain", "terrain_slope_deg"},
+                                                       {"cruise_speed", "speed_m_s"},
+                                                       {"static", "static_s"},
+                                                       {"radius", "vehicle.wheel_radius_m"},
+                                                       {"track", "vehicle.track_m"},
+                                                       {"rate", "rate_hz"},
+                                                       {"duration", "duration_s"},
+                                                       {"speed", "speed_file"}};
+  return a;
+}
+
+/// `v` with every reference "${KEY}", "${KEY}*N" or "${KEY}/N" (a whole text value, also
+/// inside lists and maps) replaced by the value `lookup` gives (times or over N).
+YAML::Node substitute(
+    const YAML::Node& v,
+    const std::function<std::string(const std::string&, const std::string&)>& lookup,
+    const std::string& where) {
+  if (v.IsSequence()) {
+    YAML::Node out(YAML::NodeType::Sequence);
+    for (const auto& x : v) out.push_back(substitute(x, lookup, where));
+    return out;
+  }
+  if (v.IsMap()) {
+    YAML::Node out(YAML::NodeType::Map);
+    for (const auto& kv : v) out[kv.first.as<std::string>()] = substitute(kv.second, lookup, where);
+    return out;
+  }
+  if (!v.IsScalar() || v.Scalar().find("${") == std::string::npos) return YAML::Clone(v);
+  static const std::regex ref(R"(^\s*\$\{([A-Za-z0-9_.\-]+)\}\s*(?:([*/])\s*([-+0-9.eE]+))?\s*$)");
+  std::smatch m;
+  const std::string text = v.Scalar();
+  if (!std::regex_match(text, m, ref))
+    throw InputError(where + ": '" + text +
+                     "': a reference is a whole value: ${KEY}, ${KEY}*N or ${KEY}/N");
+  const std::string value = lookup(m[1].str(), where);
+  if (!m[2].matched) return YAML::Node(value);
+  const auto x = io_detail::parse_double(value), f = io_detail::parse_double(m[3].str());
+  if (!x || !f)
+    throw InputError(where + ": '" + text + "': " + m[1].str() + " = '" + value +
+                     "' is not a number");
+  return YAML::Node(io_detail::format_double(m[2].str() == "*" ? *x * *f : *x / *f));
 }
 
 }  // namespace
@@ -457,7 +505,7 @@ Study Study::load(const fs::path& file, const LoadOptions& options) {
   y.check_keys(root, "",
                {"name", "description", "results", "cache", "dataset", "simulate", "run", "manifest",
                 "configurations", "seeds", "replicates", "sweep", "compare", "interval",
-                "confidence", "resamples", "experiment"});
+                "confidence", "resamples", "experiment", "keep_datasets"});
   Study s;
   s.file_ = fs::absolute(file).lexically_normal();
   s.dir_ = s.file_.parent_path();
@@ -498,6 +546,9 @@ Study Study::load(const fs::path& file, const LoadOptions& options) {
       y.fail("resamples", "a whole number in [100, 1e7]", &v);
     s.interval_.resamples = static_cast<int>(r);
   }
+
+  if (auto v = YamlReader::get(root, "keep_datasets"); v.IsDefined())
+    s.keep_datasets_ = y.boolean(v, "keep_datasets");
 
   // Fixed settings.
   if (auto v = YamlReader::get(root, "dataset"); v.IsDefined())
@@ -620,6 +671,7 @@ std::size_t Study::job_count() const {
 }
 
 Job Study::job(std::size_t k) const {
+  const std::lock_guard<std::mutex> lock(*mutex_);
   if (k >= job_count())
     throw InputError("job " + std::to_string(k) + ": the study '" + file_.string() +
                      "' has jobs 0.." + std::to_string(job_count() - 1));
@@ -701,6 +753,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
   std::optional<bool> earth_rotation;
   std::string edits;
   std::optional<std::string> configuration, chip;
+  std::vector<const Setting*> later;
   for (const Setting& s : settings) {
     if (s.key == "dataset") {
       dataset = rel(text_of(s));
@@ -712,15 +765,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
       sim_where = s.where;
       std::string key = s.key == "seed" ? "seed" : s.key.substr(9);
       const std::string first = split_dots(key)[0];
-      static const std::map<std::string, std::string> alias = {{"preset", "vehicle.preset"},
-                                                               {"terrain", "terrain_slope_deg"},
-                                                               {"cruise_speed", "speed_m_s"},
-                                                               {"static", "static_s"},
-                                                               {"radius", "vehicle.wheel_radius_m"},
-                                                               {"track", "vehicle.track_m"},
-                                                               {"rate", "rate_hz"},
-                                                               {"duration", "duration_s"},
-                                                               {"speed", "speed_file"}};
+      const auto& alias = sim_alias();
       if (key == "config")
         sim_configs.push_back(rel(text_of(s)).string());
       else if (key == "set")
@@ -755,43 +800,8 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
       }
       continue;
     }
-    if (s.key.rfind("run.", 0) == 0) {
-      const std::string key = s.key.substr(4);
-      if (key == "dataset")
-        throw InputError(who + ": " + s.where +
-                         ": run.dataset: give the data with `dataset` or `simulate`");
-      run_tree.set(split_dots(key), 0, s.value);
-      continue;
-    }
-    if (s.key.rfind("manifest.", 0) == 0) {
-      edits += "- " + yaml_key(s.key.substr(9)) + ": " + flow(s.value) + "\n";
-      continue;
-    }
-    if (s.key == "configuration") {
-      configuration = text_of(s);
-      continue;
-    }
-    if (s.key == "chip") {
-      chip = text_of(s);
-      continue;
-    }
-    if (s.key == "chips" || s.key == "modules") {
-      YAML::Node seq(YAML::NodeType::Sequence);
-      for (const auto& c : list_of(s)) seq.push_back(c);
-      run_tree.set({s.key}, 0, seq);
-      continue;
-    }
-    throw InputError(who + ": " + s.where + ": unknown setting '" + s.key + "'");
+    later.push_back(&s);  // run settings and manifest edits may refer to the data's settings
   }
-  if (const Tree* out = run_tree.find("output")) {
-    if (out->leaf)
-      throw InputError(who + ": run.output: expected a map (only output.interval_s applies)");
-    for (const auto& kv : out->kids)
-      if (kv.first != "interval_s")
-        throw InputError(who + ": run.output." + kv.first +
-                         ": a study writes no trajectories (only output.interval_s applies)");
-  }
-
   // The data.
   DatasetSpec& d = j.dataset;
   if (dataset && !sim_where.empty())
@@ -801,10 +811,6 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
     d.manifest = *dataset;
     d.canonical = "manifest: " + dataset->string() +
                   "\nmanifest_text: " + fnv_of_file(*dataset, "manifest") + "\n";
-    // Edits of a manifest that is not ours go into the cache (the data stay where they are).
-    if (!edits.empty())
-      d.cache_name = "edited-" + slug(dataset->parent_path().filename().string()) + "-" +
-                     hash_text(d.canonical + edits);
   } else if (!sim_where.empty() || !sim_configs.empty()) {
     sim::SimConfig c;
     c.write_ideal = false;  // the cache keeps the data a filter reads, not the error-free streams
@@ -852,7 +858,67 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
     throw InputError(who +
                      ": no data: give `dataset: MANIFEST` or simulator settings (`simulate:`)");
   }
+  // Run settings and manifest edits, with references to the data's settings resolved.
+  const YAML::Node sim_values = d.sim ? YAML::Load(d.sim->to_yaml()) : YAML::Node();
+  auto lookup = [&](const std::string& ref, const std::string& where) -> std::string {
+    std::string key = ref == "seed" ? "simulate.seed" : ref;
+    if (key.rfind("simulate.", 0) != 0)
+      throw InputError(who + ": " + where + ": ${" + ref +
+                       "}: only the data's settings can be referred to (simulate.KEY or seed)");
+    if (!d.sim)
+      throw InputError(who + ": " + where + ": ${" + ref + "}: the job's data are not simulated");
+    key = key.substr(9);
+    if (const auto a = sim_alias().find(key); a != sim_alias().end()) key = a->second;
+    if (key == "wheel_noise") key = "errors.wheel_accel_noise_m_s_sqrt_h";
+    YAML::Node n;
+    n.reset(sim_values);
+    for (const auto& part : split_dots(key)) {
+      const YAML::Node& cn = n;
+      if (!cn.IsMap() || !cn[part])
+        throw InputError(who + ": " + where + ": ${" + ref + "}: no such simulator setting");
+      n.reset(cn[part]);
+    }
+    if (!n.IsScalar())
+      throw InputError(who + ": " + where + ": ${" + ref + "}: not a single value");
+    return n.Scalar();
+  };
+  for (const Setting* sp : later) {
+    const Setting& s0 = *sp;
+    const Setting s{s0.key, substitute(s0.value, lookup, s0.where), s0.where};
+    if (s.key.rfind("run.", 0) == 0) {
+      const std::string key = s.key.substr(4);
+      if (key == "dataset")
+        throw InputError(who + ": " + s.where +
+                         ": run.dataset: give the data with `dataset` or `simulate`");
+      run_tree.set(split_dots(key), 0, s.value);
+    } else if (s.key.rfind("manifest.", 0) == 0) {
+      edits += "- " + yaml_key(s.key.substr(9)) + ": " + flow(s.value) + "\n";
+    } else if (s.key == "configuration") {
+      configuration = text_of(s);
+    } else if (s.key == "chip") {
+      chip = text_of(s);
+    } else if (s.key == "chips" || s.key == "modules") {
+      YAML::Node seq(YAML::NodeType::Sequence);
+      for (const auto& c : list_of(s)) seq.push_back(c);
+      run_tree.set({s.key}, 0, seq);
+    } else {
+      throw InputError(who + ": " + s.where + ": unknown setting '" + s.key + "'");
+    }
+  }
+  if (const Tree* out = run_tree.find("output")) {
+    if (out->leaf)
+      throw InputError(who + ": run.output: expected a map (only output.interval_s applies)");
+    for (const auto& kv : out->kids)
+      if (kv.first != "interval_s")
+        throw InputError(who + ": run.output." + kv.first +
+                         ": a study writes no trajectories (only output.interval_s applies)");
+  }
+
   d.manifest_edits = edits;
+  // Edits of a manifest that is not ours go into the cache (the data stay where they are).
+  if (d.manifest && !edits.empty())
+    d.cache_name = "edited-" + slug(d.manifest->parent_path().filename().string()) + "-" +
+                   hash_text(d.canonical + edits);
 
   // The run configuration.
   std::string cfg = configuration.value_or("");
@@ -881,6 +947,46 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
                 j.run_yaml;
   j.key = hash_text(j.canonical);
   return j;
+}
+
+std::vector<std::size_t> Study::data_siblings(std::size_t k) const {
+  if (experiment_) return {k};
+  auto changes_data = [](const Axis& a) {
+    for (const auto& v : a.values)
+      for (const auto& st : v.settings)
+        if (st.key == "dataset" || st.key == "seed" || st.key.rfind("simulate.", 0) == 0)
+          return true;
+    return false;
+  };
+  std::vector<std::size_t> choice(axes_.size());
+  std::size_t rest = k;
+  for (std::size_t i = axes_.size(); i-- > 0;) {
+    choice[i] = rest % axes_[i].values.size();
+    rest /= axes_[i].values.size();
+  }
+  std::vector<std::size_t> free;
+  for (std::size_t i = 0; i < axes_.size(); ++i)
+    if (!changes_data(axes_[i])) free.push_back(i);
+  std::vector<std::size_t> out;
+  // Every combination of the free axes, the others as in job k.
+  for (std::size_t a : free) choice[a] = 0;
+  for (bool more = true; more;) {
+    std::size_t index = 0;
+    for (std::size_t i = 0; i < axes_.size(); ++i)
+      index = index * axes_[i].values.size() + choice[i];
+    out.push_back(index);
+    more = false;
+    for (std::size_t f = free.size(); f-- > 0;) {
+      const std::size_t a = free[f];
+      if (++choice[a] < axes_[a].values.size()) {
+        more = true;
+        break;
+      }
+      choice[a] = 0;
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 std::vector<Job> Study::check_all() const {

@@ -23,6 +23,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -123,12 +125,17 @@ class Study {
 
   std::size_t job_count() const;
   /// Job k resolved: its dataset, run configuration and canonical text. InputError for
-  /// settings that do not go together (naming the job and the keys). Not thread-safe
-  /// (reads the YAML values); callers resolve jobs on one thread.
+  /// settings that do not go together (naming the job and the keys). Thread-safe (one job
+  /// is resolved at a time: the YAML values are not safe to read from several threads).
   Job job(std::size_t k) const;
   /// Every job resolved and every distinct run configuration checked by load_run_config
   /// (so a misspelt key fails before any job runs). Returns the jobs.
   std::vector<Job> check_all() const;
+  /// The jobs whose data are job k's (k included): the other values of the axes that do
+  /// not change the data.
+  std::vector<std::size_t> data_siblings(std::size_t k) const;
+  /// `keep_datasets: false`: a simulated dataset is deleted when every job on it is done.
+  bool keep_datasets() const { return keep_datasets_; }
 
  private:
   Job resolve(std::size_t k, const std::vector<std::size_t>& choice,
@@ -141,6 +148,8 @@ class Study {
   std::vector<std::pair<std::string, std::string>> compare_;
   std::optional<ExperimentSpec> experiment_;
   std::vector<eval::ExperimentRun> experiment_runs_;
+  bool keep_datasets_ = true;
+  std::shared_ptr<std::mutex> mutex_ = std::make_shared<std::mutex>();
 };
 
 /// The run configuration of `run_yaml` on `manifest`, read by load_run_config (through a
