@@ -650,3 +650,24 @@ TEST(StudyRun, JobListParsing) {
   EXPECT_HAS(iotest::error_of([] { parse_job_list("x", 10); }), "not a job number");
   EXPECT_HAS(iotest::error_of([] { parse_job_list("5-2", 10); }), "empty");
 }
+
+TEST(StudyRun, ExampleStudiesAreValid) {
+  // studies/*.yaml: every axis value resolves and every run configuration reads.
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(WHEELINS_SOURCE_DIR) / "studies")) {
+    if (e.path().extension() != ".yaml") continue;
+    ++files;
+    LoadOptions o;
+    ScratchDir d;
+    o.results_dir = d.path();  // nothing is written next to the examples
+    const Study s = Study::load(e.path(), o);
+    std::set<std::string> checked;
+    const std::size_t n = s.job_count(), step = std::max<std::size_t>(1, n / 97);
+    for (std::size_t k = 0; k < n; k += step) {
+      const Job j = s.job(k);
+      if (checked.insert(j.run_yaml).second) check_run_yaml(j.run_yaml, e.path().string());
+    }
+    EXPECT_GT(n, 100u) << e.path();
+  }
+  EXPECT_GE(files, 2);
+}

@@ -204,6 +204,17 @@ const std::map<std::string, std::string>& sim_alias() {
   return a;
 }
 
+/// Every scalar of `n` by its dotted key.
+void flatten(const YAML::Node& n, const std::string& prefix,
+             std::map<std::string, std::string>& out) {
+  if (n.IsMap()) {
+    for (const auto& kv : n)
+      flatten(kv.second, prefix + (prefix.empty() ? "" : ".") + kv.first.as<std::string>(), out);
+  } else if (n.IsScalar()) {
+    out[prefix] = n.Scalar();
+  }
+}
+
 /// `v` with every reference "${KEY}", "${KEY}*N" or "${KEY}/N" (a whole text value, also
 /// inside lists and maps) replaced by the value `lookup` gives (times or over N).
 YAML::Node substitute(
@@ -804,6 +815,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
   }
   // The data.
   DatasetSpec& d = j.dataset;
+  const std::map<std::string, std::string>* sim_values = nullptr;  // dotted key -> value
   if (dataset && !sim_where.empty())
     throw InputError(who + ": both a dataset (" + dataset_where + ") and simulator settings (" +
                      sim_where + "): a job navigates one or the other");
@@ -812,54 +824,75 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
     d.canonical = "manifest: " + dataset->string() +
                   "\nmanifest_text: " + fnv_of_file(*dataset, "manifest") + "\n";
   } else if (!sim_where.empty() || !sim_configs.empty()) {
-    sim::SimConfig c;
-    c.write_ideal = false;  // the cache keeps the data a filter reads, not the error-free streams
-    const std::string where = who + ": simulator settings";
-    for (const auto& f : sim_configs) {
-      YAML::Node node;
-      try {
-        node = YAML::LoadFile(f);
-      } catch (const YAML::Exception& e) {
-        throw InputError(where + ": '" + f + "': " + e.what());
-      }
-      c.apply_yaml(node, where + " ('" + f + "')");
+    // The same simulator settings give the same data: resolved once per study (a sweep has
+    // many jobs per dataset).
+    std::string memo_key = sim_tree.text() + "\n--";
+    for (const auto* list : {&sim_configs, &sim_sets, &faults, &disable}) {
+      memo_key += "--\n";
+      for (const auto& x : *list) memo_key += x + "\n";
     }
-    if (!sim_tree.kids.empty()) {
-      YAML::Node node;
+    memo_key += "--" + wheel_noise.value_or("-") + "\n";
+    if (only)
+      for (const auto& x : *only) memo_key += "only " + x + "\n";
+    if (earth_rotation) memo_key += *earth_rotation ? "earth\n" : "no earth\n";
+    auto& memo = *sim_memo_;
+    if (const auto it = memo.find(memo_key); it != memo.end()) {
+      d = it->second.data;
+      sim_values = &it->second.values;
+    } else {
+      sim::SimConfig c;
+      c.write_ideal = false;  // the cache keeps the data a filter reads, not the error-free streams
+      const std::string where = who + ": simulator settings";
+      for (const auto& f : sim_configs) {
+        YAML::Node node;
+        try {
+          node = YAML::LoadFile(f);
+        } catch (const YAML::Exception& e) {
+          throw InputError(where + ": '" + f + "': " + e.what());
+        }
+        c.apply_yaml(node, where + " ('" + f + "')");
+      }
+      if (!sim_tree.kids.empty()) {
+        YAML::Node node;
+        try {
+          node = YAML::Load(sim_tree.text());
+        } catch (const YAML::Exception& e) {
+          throw InputError(where + ": " + e.what());
+        }
+        c.apply_yaml(node, where);
+      }
       try {
-        node = YAML::Load(sim_tree.text());
-      } catch (const YAML::Exception& e) {
+        for (const auto& a : sim_sets) c.apply_setting(a);
+        if (wheel_noise) {
+          c.apply_setting("errors.wheel_accel_noise_m_s_sqrt_h=" + *wheel_noise);
+          c.effects.insert("wheel_noise");
+        }
+        for (const auto& f : faults) c.faults.push_back(sim::parse_fault_spec(f));
+        if (only) c.only(*only);
+        c.disable(disable);
+        if (earth_rotation) c.earth_rotation = *earth_rotation;
+      } catch (const InputError& e) {
         throw InputError(where + ": " + e.what());
       }
-      c.apply_yaml(node, where);
+      d.canonical = "wheelins study dataset 1\n" + c.to_yaml();
+      if (c.scenario != "default")
+        d.canonical += "scenario_file: " + fnv_of_file(c.scenario, "scenario file") + "\n";
+      if (c.speed_file)
+        d.canonical += "speed_file: " + fnv_of_file(*c.speed_file, "speed file") + "\n";
+      d.cache_name = slug(c.vehicle.preset + "-" + c.profile + "-seed" + std::to_string(c.seed)) +
+                     "-" + hash_text(d.canonical);
+      d.sim = std::move(c);
+      if (memo.size() > 100000) memo.clear();
+      SimMemo& m = memo[memo_key];
+      m.data = d;
+      flatten(YAML::Load(d.sim->to_yaml()), "", m.values);
+      sim_values = &m.values;
     }
-    try {
-      for (const auto& a : sim_sets) c.apply_setting(a);
-      if (wheel_noise) {
-        c.apply_setting("errors.wheel_accel_noise_m_s_sqrt_h=" + *wheel_noise);
-        c.effects.insert("wheel_noise");
-      }
-      for (const auto& f : faults) c.faults.push_back(sim::parse_fault_spec(f));
-      if (only) c.only(*only);
-      c.disable(disable);
-      if (earth_rotation) c.earth_rotation = *earth_rotation;
-    } catch (const InputError& e) {
-      throw InputError(where + ": " + e.what());
-    }
-    d.canonical = "wheelins study dataset 1\n" + c.to_yaml();
-    if (c.scenario != "default")
-      d.canonical += "scenario_file: " + fnv_of_file(c.scenario, "scenario file") + "\n";
-    if (c.speed_file)
-      d.canonical += "speed_file: " + fnv_of_file(*c.speed_file, "speed file") + "\n";
-    d.cache_name = slug(c.vehicle.preset + "-" + c.profile + "-seed" + std::to_string(c.seed)) +
-                   "-" + hash_text(d.canonical);
-    d.sim = std::move(c);
   } else {
     throw InputError(who +
                      ": no data: give `dataset: MANIFEST` or simulator settings (`simulate:`)");
   }
   // Run settings and manifest edits, with references to the data's settings resolved.
-  const YAML::Node sim_values = d.sim ? YAML::Load(d.sim->to_yaml()) : YAML::Node();
   auto lookup = [&](const std::string& ref, const std::string& where) -> std::string {
     std::string key = ref == "seed" ? "simulate.seed" : ref;
     if (key.rfind("simulate.", 0) != 0)
@@ -870,17 +903,11 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
     key = key.substr(9);
     if (const auto a = sim_alias().find(key); a != sim_alias().end()) key = a->second;
     if (key == "wheel_noise") key = "errors.wheel_accel_noise_m_s_sqrt_h";
-    YAML::Node n;
-    n.reset(sim_values);
-    for (const auto& part : split_dots(key)) {
-      const YAML::Node& cn = n;
-      if (!cn.IsMap() || !cn[part])
-        throw InputError(who + ": " + where + ": ${" + ref + "}: no such simulator setting");
-      n.reset(cn[part]);
-    }
-    if (!n.IsScalar())
-      throw InputError(who + ": " + where + ": ${" + ref + "}: not a single value");
-    return n.Scalar();
+    const auto it = sim_values->find(key);
+    if (it == sim_values->end())
+      throw InputError(who + ": " + where + ": ${" + ref +
+                       "}: no such simulator setting (a single value)");
+    return it->second;
   };
   for (const Setting* sp : later) {
     const Setting& s0 = *sp;

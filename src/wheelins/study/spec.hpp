@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -150,6 +151,14 @@ class Study {
   std::vector<eval::ExperimentRun> experiment_runs_;
   bool keep_datasets_ = true;
   std::shared_ptr<std::mutex> mutex_ = std::make_shared<std::mutex>();
+  /// Simulator settings already resolved (their text -> the data, and every setting of the
+  /// data as dotted key -> value for references), under mutex_.
+  struct SimMemo {
+    DatasetSpec data;
+    std::map<std::string, std::string> values;
+  };
+  std::shared_ptr<std::map<std::string, SimMemo>> sim_memo_ =
+      std::make_shared<std::map<std::string, SimMemo>>();
 };
 
 /// The run configuration of `run_yaml` on `manifest`, read by load_run_config (through a
