@@ -18,18 +18,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::string> split_dots(const std::string& key) {
-  std::vector<std::string> parts;
-  std::size_t pos = 0;
-  while (true) {
-    const auto dot = key.find('.', pos);
-    parts.push_back(key.substr(pos, dot == std::string::npos ? std::string::npos : dot - pos));
-    if (dot == std::string::npos) break;
-    pos = dot + 1;
-  }
-  return parts;
-}
-
 bool whole_number(const std::string& s) {
   return !s.empty() && s.size() < 9 &&
          std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
@@ -113,7 +101,7 @@ std::string edit_manifest(const std::string& text, const std::string& edits,
     for (const auto& kv : item) {
       const std::string key = kv.first.as<std::string>();
       int matched = 0;
-      apply_edit(root, split_dots(key), 0, kv.second, matched);
+      apply_edit(root, split_dotted(key), 0, kv.second, matched);
       if (matched == 0 && !kv.second.IsNull())
         throw InputError(where + ": manifest." + key + " matches nothing in the manifest");
     }

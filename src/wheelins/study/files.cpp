@@ -17,12 +17,16 @@
 namespace wheelins::study {
 namespace fs = std::filesystem;
 
+std::string host_name() {
+  char host[256] = "";
+  if (::gethostname(host, sizeof host - 1) != 0 || host[0] == '\0') return "host";
+  host[sizeof host - 1] = '\0';
+  return host;
+}
+
 std::string unique_suffix() {
   static std::atomic<unsigned> counter{0};
-  char host[256] = "host";
-  if (::gethostname(host, sizeof host - 1) != 0) std::strcpy(host, "host");
-  host[sizeof host - 1] = '\0';
-  return std::string(host) + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  return host_name() + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
 }
 
 bool read_file(const fs::path& file, std::string& out) {

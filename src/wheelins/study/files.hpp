@@ -25,6 +25,9 @@ void write_file_atomic(const std::filesystem::path& file, std::string_view text,
 /// The whole file; nullopt-like empty string and false when it cannot be read.
 bool read_file(const std::filesystem::path& file, std::string& out);
 
+/// This machine's name ("host" if it has none).
+std::string host_name();
+
 /// A unique suffix for temporary names: host, process id and a counter.
 std::string unique_suffix();
 

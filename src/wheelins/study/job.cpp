@@ -41,13 +41,6 @@ double unix_now() {
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
-std::string host_name() {
-  char host[256] = "";
-  if (::gethostname(host, sizeof host - 1) != 0) return "?";
-  host[sizeof host - 1] = '\0';
-  return host;
-}
-
 fs::path result_file(const Study& s, std::size_t k) {
   return s.jobs_dir() / (std::to_string(k) + ".json");
 }

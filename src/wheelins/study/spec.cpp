@@ -25,6 +25,18 @@
 namespace wheelins::study {
 namespace fs = std::filesystem;
 
+std::vector<std::string> split_dotted(const std::string& key) {
+  std::vector<std::string> parts;
+  std::size_t pos = 0;
+  while (true) {
+    const auto dot = key.find('.', pos);
+    parts.push_back(key.substr(pos, dot == std::string::npos ? std::string::npos : dot - pos));
+    if (dot == std::string::npos) break;
+    pos = dot + 1;
+  }
+  return parts;
+}
+
 std::string hash_text(const std::string& text) {
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (unsigned char c : text) h = (h ^ c) * 0x100000001b3ull;
@@ -59,18 +71,6 @@ std::string yaml_key(const std::string& k) {
   YAML::Emitter e;
   e << YAML::DoubleQuoted << k;
   return e.c_str();
-}
-
-std::vector<std::string> split_dots(const std::string& key) {
-  std::vector<std::string> parts;
-  std::size_t pos = 0;
-  while (true) {
-    const auto dot = key.find('.', pos);
-    parts.push_back(key.substr(pos, dot == std::string::npos ? std::string::npos : dot - pos));
-    if (dot == std::string::npos) break;
-    pos = dot + 1;
-  }
-  return parts;
 }
 
 /// Settings merged by dotted path: maps merge key by key, anything else replaces. Keys are
@@ -384,7 +384,7 @@ struct Loader {
     Axis a;
     a.role = role;
     if (is_setting_key(name)) {
-      const auto parts = split_dots(name);
+      const auto parts = split_dotted(name);
       a.name = parts.back();
       for (const auto& x : values(v, where))
         a.values.push_back({label_of(x), {setting(name, x, where)}});
@@ -775,7 +775,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
     if (s.key == "seed" || s.key.rfind("simulate.", 0) == 0) {
       sim_where = s.where;
       std::string key = s.key == "seed" ? "seed" : s.key.substr(9);
-      const std::string first = split_dots(key)[0];
+      const std::string first = split_dotted(key)[0];
       const auto& alias = sim_alias();
       if (key == "config")
         sim_configs.push_back(rel(text_of(s)).string());
@@ -803,10 +803,10 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
         if (const auto a = alias.find(first); a != alias.end() && key == first) key = a->second;
         if (key == "scenario" || key == "speed_file") {
           const std::string p = text_of(s);
-          sim_tree.set(split_dots(key), 0,
+          sim_tree.set(split_dotted(key), 0,
                        YAML::Node(key == "scenario" && p == "default" ? p : rel(p).string()));
         } else {
-          sim_tree.set(split_dots(key), 0, s.value);
+          sim_tree.set(split_dotted(key), 0, s.value);
         }
       }
       continue;
@@ -917,7 +917,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
       if (key == "dataset")
         throw InputError(who + ": " + s.where +
                          ": run.dataset: give the data with `dataset` or `simulate`");
-      run_tree.set(split_dots(key), 0, s.value);
+      run_tree.set(split_dotted(key), 0, s.value);
     } else if (s.key.rfind("manifest.", 0) == 0) {
       edits += "- " + yaml_key(s.key.substr(9)) + ": " + flow(s.value) + "\n";
     } else if (s.key == "configuration") {

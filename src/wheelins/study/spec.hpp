@@ -173,6 +173,9 @@ void check_run_yaml(const std::string& run_yaml, const std::string& where);
 /// The study file text of the built-in experiment on `spec` (results in the file's directory).
 std::string experiment_study_yaml(const ExperimentSpec& spec);
 
+/// "a.b.c" -> {"a", "b", "c"}.
+std::vector<std::string> split_dotted(const std::string& key);
+
 /// FNV-1a 64 of `text` as 16 hex digits.
 std::string hash_text(const std::string& text);
 
