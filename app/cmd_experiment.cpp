@@ -53,6 +53,9 @@ int run(const Args& a) {
     // Only the study file: its jobs run with `wheelins study run` (sharded, resumable) and
     // `wheelins study report` writes the tables into the same directory.
     const fs::path study_file = final_out / "study.yaml";
+    if (fs::exists(final_out / kOutputMarker))
+      throw InputError("'" + final_out.string() + "': holds the finished output of `wheelins experiment`; "
+                       "prepare the study in another directory");
     std::string existing;
     if (study::read_file(study_file, existing)) {
       if (existing != text && !a.force)

@@ -11,6 +11,7 @@
 #include "wheelins/study/job.hpp"
 #include "wheelins/study/report.hpp"
 #include "wheelins/study/spec.hpp"
+#include "wheelins/util/interrupt.hpp"
 
 namespace {
 using namespace wheelins;
@@ -131,7 +132,17 @@ int run(const Args& a) {
     std::printf("study %s: %zu jobs (%s) on %d threads; results in %s\n", s.name().c_str(),
                 s.job_count(), dims_text(s).c_str(), o.workers, s.results_dir().c_str());
   std::cout << std::flush;
-  const RunSummary r = run_jobs(s, list, o);
+  RunSummary r;
+  try {
+    r = run_jobs(s, list, o);
+  } catch (const Interrupted&) {
+    std::size_t done = 0;
+    for (std::size_t k = 0; k < s.job_count(); ++k) done += job_status(s, s.job(k)).state == JobState::kDone;
+    std::cerr << "\nerror: interrupted; " << done << " of " << s.job_count()
+              << " jobs are done and kept (the running ones wrote nothing): run the same command again to do "
+                 "the rest\n";
+    return 130;
+  }
   if (!a.quiet) {
     if (r.already_done == r.requested)
       std::printf("%s already done (--rerun runs again)\n",

@@ -3,6 +3,7 @@
 // command, shuffled --job calls, GNU parallel, a Slurm array task by task).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -618,14 +619,63 @@ TEST(StudyRun, ExperimentIsABuiltInStudy) {
     return out;
   };
   EXPECT_EQ(metrics(slurp(d / "sharded" / "runs.csv")), metrics(slurp(d / "one" / "runs.csv")));
+  // The one command's output appears as a whole: the study, its jobs, the tables.
+  EXPECT_TRUE(fs::exists(d / "one" / "jobs" / "0.json"));
+  EXPECT_TRUE(fs::exists(d / "one" / ".wheelins"));
   // Existing results are refused without --force, as before; another experiment's study too.
-  const Cmd again = shell(
-      bin() + " experiment data -o one --only single,triple,centralized --no-plots -q", d.path());
+  const Cmd again =
+      shell(bin() + " experiment data -o one --only single,triple,centralized --no-plots -q", d.path());
   EXPECT_EQ(again.code, 2);
   EXPECT_HAS(again.err, "already holds experiment");
   const Cmd other = shell(bin() + " experiment data -o sharded --only single --prepare", d.path());
   EXPECT_EQ(other.code, 2);
   EXPECT_HAS(other.err, "holds the study of another experiment");
+  const Cmd full = shell(bin() + " experiment data -o one --prepare", d.path());
+  EXPECT_EQ(full.code, 2);
+  EXPECT_HAS(full.err, "holds the finished output of `wheelins experiment`");
+  fs::create_directories(d / "mine");
+  put(d / "mine" / "notes.txt", "the user's file");
+  const Cmd foreign = shell(bin() + " experiment data -o mine --prepare", d.path());
+  EXPECT_EQ(foreign.code, 2);
+  EXPECT_HAS(foreign.err, "is not empty");
+}
+
+TEST(StudyRun, InterruptedRunKeepsFinishedJobsAndResumes) {
+  ScratchDir d;
+  std::string text = kSmall;
+  text.replace(text.find("seeds: [1, 2]"), 13, "seeds: 1..5");
+  put(d / "s.yaml", text);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::execl(WHEELINS_BINARY, WHEELINS_BINARY, "study", "run", (d / "s.yaml").c_str(), "-j", "1", "--no-report",
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const Study s = Study::load(d / "s.yaml");
+  // Wait for a first finished job, then Ctrl-C.
+  for (int i = 0; i < 400 && !fs::exists(s.jobs_dir() / "0.json"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 130) << "the study finished before the interrupt";
+  std::size_t done = 0;
+  for (std::size_t k = 0; k < s.job_count(); ++k) {
+    const JobState st = job_status(s, s.job(k)).state;
+    EXPECT_TRUE(st == JobState::kDone || st == JobState::kMissing) << "job " << k << ": " << job_state_name(st);
+    done += st == JobState::kDone;
+  }
+  EXPECT_GE(done, 1u);
+  EXPECT_LT(done, s.job_count());
+  for (const auto& e : fs::directory_iterator(s.jobs_dir()))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+  const Cmd resume = shell(bin() + " study run s.yaml --no-report", d.path());
+  ASSERT_EQ(resume.code, 0) << resume.err;
+  EXPECT_HAS(resume.out, "(" + std::to_string(done) + " were done before)");
 }
 
 TEST(StudyRun, DatasetsDeletedWhenEveryJobOnThemIsDone) {

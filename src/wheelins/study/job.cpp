@@ -26,6 +26,7 @@
 #include "wheelins/run/run_config.hpp"
 #include "wheelins/study/dataset.hpp"
 #include "wheelins/study/json.hpp"
+#include "wheelins/util/interrupt.hpp"
 
 namespace wheelins::study {
 namespace fs = std::filesystem;
@@ -332,6 +333,8 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     for (const auto& [file, text] : side) write_file_atomic(file, text);
     write_file_atomic(result_file(s, j.index), result, o.write_chunk);
     tm.write = since(t);
+  } catch (const Interrupted&) {
+    throw;  // Ctrl-C or a kill: not a failure of the job (nothing of it is written)
   } catch (const std::exception& e) {
     out.error = e.what();
     // A result of these settings from before (a rerun) is not this run's: leave none behind.
@@ -483,7 +486,7 @@ RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const
     for (std::size_t i = next++; i < total; i = next++) {
       {
         std::lock_guard<std::mutex> lock(mutex);
-        if (fatal) return;
+        if (fatal || interrupt_requested()) return;
         ++running;
       }
       JobOutcome r;
@@ -524,14 +527,15 @@ RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const
   for (int k = 0; k < workers; ++k) threads.emplace_back(worker);
   {
     std::unique_lock<std::mutex> lock(mutex);
-    while (finished < total && !(fatal && running == 0)) {
-      cv.wait_for(lock, std::chrono::seconds(1));
+    while (finished < total && !((fatal || interrupt_requested()) && running == 0)) {
+      cv.wait_for(lock, std::chrono::milliseconds(interrupt_requested() ? 50 : 1000));
       if (tty) progress_line();
     }
   }
   for (auto& t : threads) t.join();
   if (tty) std::fprintf(stderr, "\n");
   if (fatal) std::rethrow_exception(fatal);
+  check_interrupt();  // interrupted between jobs
   std::sort(sum.failures.begin(), sum.failures.end());
   sum.seconds = since(t0);
   return sum;

@@ -49,7 +49,8 @@ struct JobOptions {
 };
 
 /// Runs one job and writes its result (or its failure). Never throws for a failure of the
-/// job itself (returned, and written as K.failed.json); throws if not even that can be written.
+/// job itself (returned, and written as K.failed.json); throws Interrupted (nothing written)
+/// on an interrupt, and an error if not even the failure can be written.
 JobOutcome run_job(const Study& study, const Job& job, const JobOptions& options = {});
 
 /// With `keep_datasets: false`: deletes job j's simulated dataset if every job on it is done
@@ -82,7 +83,9 @@ struct RunSummary {
 
 /// Runs the jobs `indices` (all of the study when empty) that are not done, on
 /// `workers` threads. The run settings of those jobs are checked first (InputError before
-/// anything runs). Interrupted, it leaves the finished jobs; run again, it does the rest.
+/// anything runs). Interrupted (util/interrupt.hpp: Ctrl-C, a kill), the running jobs stop
+/// and write nothing, the finished ones are kept, and Interrupted is thrown; run again, it
+/// does the rest.
 RunSummary run_jobs(const Study& study, const std::vector<std::size_t>& indices,
                     const RunOptions& options);
 
