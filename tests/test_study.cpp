@@ -432,9 +432,9 @@ TEST(StudyRun, FailingResultWriterLeavesNoResult) {
 
 TEST(StudyRun, KilledJobLeavesNoCompleteResultAndResumes) {
   ScratchDir d;
-  // Long enough (car, 300 s) to be killed while generating or navigating.
+  // Long enough (car, 150 s) to be killed while generating or navigating.
   put(d / "s.yaml",
-      "simulate: {preset: car, chips: 1, static_s: 10, duration_s: 300}\n"
+      "simulate: {preset: car, chips: 1, static_s: 10, duration_s: 150}\n"
       "configurations: [triple]\n");
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);

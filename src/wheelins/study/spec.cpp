@@ -12,7 +12,6 @@
 #include <fstream>
 #include <functional>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -232,19 +231,35 @@ YAML::Node substitute(
     return out;
   }
   if (!v.IsScalar() || v.Scalar().find("${") == std::string::npos) return YAML::Clone(v);
-  static const std::regex ref(R"(^\s*\$\{([A-Za-z0-9_.\-]+)\}\s*(?:([*/])\s*([-+0-9.eE]+))?\s*$)");
-  std::smatch m;
+  // "${KEY}" [*|/ NUMBER], blanks allowed around the parts.
   const std::string text = v.Scalar();
-  if (!std::regex_match(text, m, ref))
-    throw InputError(where + ": '" + text +
-                     "': a reference is a whole value: ${KEY}, ${KEY}*N or ${KEY}/N");
-  const std::string value = lookup(m[1].str(), where);
-  if (!m[2].matched) return YAML::Node(value);
-  const auto x = io_detail::parse_double(value), f = io_detail::parse_double(m[3].str());
-  if (!x || !f)
-    throw InputError(where + ": '" + text + "': " + m[1].str() + " = '" + value +
-                     "' is not a number");
-  return YAML::Node(io_detail::format_double(m[2].str() == "*" ? *x * *f : *x / *f));
+  auto bad = [&]() {
+    return InputError(where + ": '" + text +
+                      "': a reference is a whole value: ${KEY}, ${KEY}*N or ${KEY}/N");
+  };
+  auto trim = [](std::string t) {
+    while (!t.empty() && std::isspace(static_cast<unsigned char>(t.front()))) t.erase(t.begin());
+    while (!t.empty() && std::isspace(static_cast<unsigned char>(t.back()))) t.pop_back();
+    return t;
+  };
+  const std::string t = trim(text);
+  const auto close = t.find('}');
+  if (t.rfind("${", 0) != 0 || close == std::string::npos) throw bad();
+  const std::string key = t.substr(2, close - 2);
+  if (key.empty() || !std::all_of(key.begin(), key.end(), [](unsigned char c) {
+        return std::isalnum(c) || c == '_' || c == '.' || c == '-';
+      }))
+    throw bad();
+  const std::string rest = trim(t.substr(close + 1));
+  const std::string value = lookup(key, where);
+  if (rest.empty()) return YAML::Node(value);
+  const char op = rest[0];
+  const auto f = io_detail::parse_double(rest.substr(1));
+  if ((op != '*' && op != '/') || !f) throw bad();
+  const auto x = io_detail::parse_double(value);
+  if (!x)
+    throw InputError(where + ": '" + text + "': " + key + " = '" + value + "' is not a number");
+  return YAML::Node(io_detail::format_double(op == '*' ? *x * *f : *x / *f));
 }
 
 }  // namespace
