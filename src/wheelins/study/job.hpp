@@ -89,6 +89,11 @@ struct RunSummary {
 RunSummary run_jobs(const Study& study, const std::vector<std::size_t>& indices,
                     const RunOptions& options);
 
+/// The format of a result file K.json, and the text every complete one ends with: a result
+/// without it (cut short) is not done.
+inline constexpr const char* kJobResultFormat = "wheelins-study-job-1";
+inline constexpr const char* kJobResultTail = "\"status\": \"done\"\n}\n";
+
 /// A finished job as read back from K.json.
 struct JobRecord {
   std::size_t index = 0;

@@ -14,39 +14,14 @@
 #include "wheelins/nav/types.hpp"
 #include "wheelins/run/experiment.hpp"
 #include "wheelins/study/json.hpp"
+#include "wheelins/study/report_data.hpp"
 #include "wheelins/study/stats.hpp"
 
 namespace wheelins::study {
 namespace fs = std::filesystem;
+using namespace report_detail;
 
 namespace {
-
-struct Metric {
-  const char* key;
-  const char* title;
-  const char* unit;
-  int decimals;
-  double (*get)(const JobRecord&);
-};
-
-const Metric kMetrics[] = {
-    {"drift_rate_pct", "Drift rate", "%", 3,
-     [](const JobRecord& r) { return 100.0 * r.eval.drift_rate; }},
-    {"heading_rmse_deg", "Heading RMSE", "deg", 2,
-     [](const JobRecord& r) { return r.eval.heading_rmse / kDeg; }},
-    {"max_error_m", "Max horizontal error", "m", 2,
-     [](const JobRecord& r) { return r.eval.max_error; }},
-    {"final_error_m", "Final horizontal error", "m", 2,
-     [](const JobRecord& r) { return r.eval.final_error; }},
-    {"rms_error_m", "RMS horizontal error", "m", 2,
-     [](const JobRecord& r) { return r.eval.rms_error; }},
-    {"within_3sigma_pct", "Within 3 sigma", "%", 1,
-     [](const JobRecord& r) { return 100.0 * r.eval.within_3sigma; }},
-    {"mean_nees_h", "Mean horizontal NEES", "", 2,
-     [](const JobRecord& r) { return r.eval.mean_nees; }},
-};
-constexpr int kDrift = 0, kHeading = 1, k3Sigma = 5, kNees = 6;
-constexpr int kMetricCount = static_cast<int>(sizeof kMetrics / sizeof kMetrics[0]);
 
 std::string fmt(double v, int decimals) {
   if (!std::isfinite(v)) return "-";
@@ -56,11 +31,6 @@ std::string fmt(double v, int decimals) {
   if (t[0] == '-' && t.find_first_of("123456789") == std::string::npos)
     return t.substr(1);  // no "-0.00"
   return t;
-}
-std::string exact(double v) {
-  std::string s;
-  if (std::isfinite(v)) append_double(s, v);
-  return s;
 }
 std::string csv_field(std::string s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -73,75 +43,6 @@ std::string md_cell(std::string s) {
   for (char& c : s)
     if (c == '\n') c = ' ';
   return s;
-}
-
-/// The study's layout: which axes are conditions, replicates, the configuration.
-struct Layout {
-  std::vector<std::size_t> cond, rep;
-  int cfg = -1;
-  std::size_t conditions = 1, replicates = 1, configurations = 1;
-  std::vector<std::string> config_labels;
-
-  explicit Layout(const Study& s) {
-    const auto& axes = s.axes();
-    for (std::size_t i = 0; i < axes.size(); ++i) {
-      if (axes[i].role == AxisRole::kCondition)
-        cond.push_back(i), conditions *= axes[i].values.size();
-      else if (axes[i].role == AxisRole::kReplicate)
-        rep.push_back(i), replicates *= axes[i].values.size();
-      else
-        cfg = static_cast<int>(i);
-    }
-    if (cfg >= 0) {
-      configurations = axes[static_cast<std::size_t>(cfg)].values.size();
-      for (const auto& v : axes[static_cast<std::size_t>(cfg)].values)
-        config_labels.push_back(v.label);
-    } else {
-      config_labels.push_back("result");
-    }
-  }
-  std::size_t index(const Job& j, const std::vector<std::size_t>& which, const Study& s) const {
-    std::size_t id = 0;
-    for (std::size_t a : which) id = id * s.axes()[a].values.size() + j.choice[a];
-    return id;
-  }
-  /// The labels of condition `c` (one per condition axis).
-  std::vector<std::string> labels(std::size_t c, const std::vector<std::size_t>& which,
-                                  const Study& s) const {
-    std::vector<std::string> out(which.size());
-    for (std::size_t i = which.size(); i-- > 0;) {
-      const auto& ax = s.axes()[which[i]];
-      out[i] = ax.values[c % ax.values.size()].label;
-      c /= ax.values.size();
-    }
-    return out;
-  }
-};
-
-struct Grid {
-  // records[condition][configuration][replicate]
-  std::vector<std::vector<std::vector<const JobRecord*>>> records;
-};
-
-Grid grid_of(const Study& s, const Layout& L, const std::vector<JobEntry>& jobs) {
-  Grid g;
-  g.records.assign(L.conditions,
-                   std::vector<std::vector<const JobRecord*>>(
-                       L.configurations, std::vector<const JobRecord*>(L.replicates, nullptr)));
-  for (const auto& e : jobs) {
-    if (!e.record) continue;
-    const std::size_t c = L.index(e.job, L.cond, s), r = L.index(e.job, L.rep, s);
-    const std::size_t k = L.cfg >= 0 ? e.job.choice[static_cast<std::size_t>(L.cfg)] : 0;
-    g.records[c][k][r] = &*e.record;
-  }
-  return g;
-}
-
-std::vector<double> values_of(const std::vector<const JobRecord*>& recs, int metric) {
-  std::vector<double> v;
-  for (const auto* r : recs)
-    if (r) v.push_back(kMetrics[metric].get(*r));
-  return v;
 }
 
 struct Paired {
@@ -178,134 +79,6 @@ std::string axis_role_name(AxisRole r) {
   return r == AxisRole::kCondition   ? "condition"
          : r == AxisRole::kReplicate ? "replicate"
                                      : "configuration";
-}
-
-const char* const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
-                               "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
-
-/// A gnuplot double-quoted string.
-std::string gq(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
-struct PlotFiles {
-  std::vector<std::pair<fs::path, std::string>> files;  ///< relative to plots/
-  std::vector<std::string> names;
-};
-
-/// One plot per metric: the mean and its interval per condition and configuration, over
-/// the single jobs' values (small points).
-void add_metric_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid& g, int metric,
-                     const std::string& name) {
-  const Metric& m = kMetrics[metric];
-  const IntervalOptions& io = s.interval();
-  std::string summary = "condition,label";
-  std::string jobs = "condition";
-  for (const auto& c : L.config_labels) {
-    summary += "," + c + "_mean," + c + "_lo," + c + "_hi";
-    jobs += "," + c;
-  }
-  summary += "\n";
-  jobs += "\n";
-  double ymax = 0.0;
-  auto condition_label = [&](std::size_t c) {
-    std::string label;
-    for (const auto& l : L.labels(c, L.cond, s)) label += (label.empty() ? "" : " / ") + l;
-    return label.empty() ? s.name() : label;
-  };
-  for (std::size_t c = 0; c < L.conditions; ++c) {
-    std::string label = condition_label(c);
-    for (char& ch : label)
-      if (ch == ',') ch = ';';
-    summary += std::to_string(c) + "," + label;
-    for (std::size_t k = 0; k < L.configurations; ++k) {
-      const Summary sm = summarize(values_of(g.records[c][k], metric), io);
-      summary += "," + exact(sm.mean) + "," + exact(sm.n >= 2 ? sm.lo : sm.mean) + "," +
-                 exact(sm.n >= 2 ? sm.hi : sm.mean);
-      if (sm.n >= 2 && std::isfinite(sm.hi)) ymax = std::max(ymax, sm.hi);
-    }
-    summary += "\n";
-    for (std::size_t r = 0; r < L.replicates; ++r) {
-      std::string row = std::to_string(c);
-      bool any = false;
-      for (std::size_t k = 0; k < L.configurations; ++k) {
-        const JobRecord* rec = g.records[c][k][r];
-        const double v = rec ? m.get(*rec) : std::nan("");
-        if (std::isfinite(v)) any = true, ymax = std::max(ymax, v);
-        row += "," + exact(v);
-      }
-      if (any) jobs += row + "\n";
-    }
-  }
-  out.files.emplace_back(fs::path("data") / (name + "_summary.csv"), summary);
-  out.files.emplace_back(fs::path("data") / (name + "_jobs.csv"), jobs);
-
-  const std::size_t K = L.configurations;
-  const double width = 0.7 / static_cast<double>(K);
-  const int px = static_cast<int>(
-      std::clamp<double>(200.0 + 70.0 * static_cast<double>(L.conditions * K), 1200.0, 4000.0));
-  const std::string unit = m.unit[0] ? std::string(" [") + m.unit + "]" : "";
-  std::string xtics;
-  std::size_t longest = 0;
-  for (std::size_t c = 0; c < L.conditions; ++c) {
-    const std::string label = condition_label(c);
-    longest = std::max(longest, label.size());
-    xtics += (c ? ", " : "") + gq(label) + " " + std::to_string(c);
-  }
-  char top[32];
-  std::snprintf(top, sizeof top, "%.4g", ymax > 0 ? 1.1 * ymax : 1.0);
-  const int bmargin = static_cast<int>(std::clamp<std::size_t>(3 + longest / 2, 4, 16));
-  std::string gp =
-      "# " + std::string(m.title) + " by condition: mean and " +
-      interval_description(io.method, io.confidence, io.resamples) +
-      " per configuration; small points: the single jobs.\n"
-      "# Written by `wheelins study report`; edit and re-run in this directory: gnuplot " +
-      name +
-      ".gp\n"
-      "if (!exists(\"outfile\")) outfile = " +
-      gq(name + ".png") +
-      "\n"
-      "set terminal pngcairo size " +
-      std::to_string(px) +
-      ",800 noenhanced font \"Sans,13\" linewidth 1.3\n"
-      "set output outfile\nset datafile separator \",\"\nset grid ytics lc rgb \"#d0d0d0\"\n"
-      "set title " +
-      gq(std::string(m.title) + " by condition - " + s.name()) +
-      " font \",15\"\n"
-      "set ylabel " +
-      gq(std::string(m.title) + unit) +
-      "\n"
-      "set xrange [-0.5:" +
-      std::to_string(L.conditions) + "-0.5]\nset yrange [0:" + exact(ymax > 0 ? 1.1 * ymax : 1.0) +
-      "]\n"
-      "set xtics (" +
-      xtics + ") rotate by -25 left nomirror\nset bmargin " + std::to_string(bmargin) +
-      "\n"
-      "set key outside top center horizontal samplen 2\nplot \\\n";
-  std::vector<std::string> parts;
-  for (std::size_t k = 0; k < K; ++k) {
-    const double off = (static_cast<double>(k) - 0.5 * static_cast<double>(K - 1)) * width;
-    char o[32], oj[32];
-    std::snprintf(o, sizeof o, "%+.4f", off);
-    std::snprintf(oj, sizeof oj, "%+.4f", off + 0.3 * width);
-    const std::string color = gq(kColors[k % 10]);
-    parts.push_back("  \"data/" + name + "_jobs.csv\" skip 1 using ($1" + oj +
-                    "):" + std::to_string(k + 2) + " with points pt 7 ps 0.5 lc rgb " + color +
-                    " notitle");
-    parts.push_back("  \"data/" + name + "_summary.csv\" skip 1 using ($1" + o +
-                    "):" + std::to_string(3 + 3 * k) + ":" + std::to_string(4 + 3 * k) + ":" +
-                    std::to_string(5 + 3 * k) + " with yerrorbars pt 5 ps 1.1 lw 2 lc rgb " +
-                    color + " title " + gq(L.config_labels[k]));
-  }
-  for (std::size_t i = 0; i < parts.size(); ++i)
-    gp += parts[i] + (i + 1 < parts.size() ? ", \\\n" : "\n");
-  out.files.emplace_back(name + ".gp", gp);
-  out.names.push_back(name);
 }
 
 // --- The generic report -----------------------------------------------------------------

@@ -1,5 +1,7 @@
-// Loading a study file (spec.hpp): settings by dotted key, the axes and their checks, the
-// built-in experiment study, and job K resolved to its dataset and run configuration.
+// Loading a study file (spec.hpp): the setting keys and their checks, the axes (sweep,
+// seeds, replicates, configurations), the built-in experiment study, and a run
+// configuration's text read by the code that reads run-configuration files. Job K is
+// resolved in resolve.cpp.
 #include "wheelins/study/spec.hpp"
 
 #include <unistd.h>
@@ -10,10 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <functional>
-#include <map>
 #include <set>
-#include <sstream>
 
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/io/text_util.hpp"
@@ -44,12 +43,7 @@ std::string hash_text(const std::string& text) {
   return buf;
 }
 
-namespace {
-
-// --- Values and settings -------------------------------------------------------
-
-/// A value as one line of flow-style YAML.
-std::string flow(const YAML::Node& v) {
+std::string flow_yaml(const YAML::Node& v) {
   if (!v.IsDefined() || v.IsNull()) return "null";
   YAML::Emitter e;
   e.SetMapFormat(YAML::Flow);
@@ -58,69 +52,9 @@ std::string flow(const YAML::Node& v) {
   return e.c_str();
 }
 
-/// A map key as YAML: plain when it is a simple name.
-std::string yaml_key(const std::string& k) {
-  const bool plain = !k.empty() &&
-                     std::all_of(k.begin(), k.end(),
-                                 [](unsigned char c) {
-                                   return std::isalnum(c) || c == '_' || c == '-' || c == '*';
-                                 }) &&
-                     k[0] != '-' && k[0] != '*';
-  if (plain) return k;
-  YAML::Emitter e;
-  e << YAML::DoubleQuoted << k;
-  return e.c_str();
-}
+namespace {
 
-/// Settings merged by dotted path: maps merge key by key, anything else replaces. Keys are
-/// kept sorted, so the text does not depend on the order the settings came in.
-struct Tree {
-  std::optional<std::string> leaf;  ///< flow YAML of a value that is not a map
-  std::map<std::string, Tree> kids;
-
-  void set(const YAML::Node& v) {
-    if (v.IsMap()) {
-      leaf.reset();
-      for (const auto& kv : v) kids[kv.first.as<std::string>()].set(kv.second);
-    } else {
-      kids.clear();
-      leaf = flow(v);
-    }
-  }
-  void set(const std::vector<std::string>& path, std::size_t i, const YAML::Node& v) {
-    if (i == path.size()) return set(v);
-    leaf.reset();
-    kids[path[i]].set(path, i + 1, v);
-  }
-  bool has(const std::vector<std::string>& path, std::size_t i = 0) const {
-    if (i == path.size()) return true;
-    const auto it = kids.find(path[i]);
-    return it != kids.end() && it->second.has(path, i + 1);
-  }
-  const Tree* find(const std::string& k) const {
-    const auto it = kids.find(k);
-    return it == kids.end() ? nullptr : &it->second;
-  }
-  void emit(std::string& out, int indent) const {
-    for (const auto& [k, t] : kids) {
-      out.append(static_cast<std::size_t>(indent), ' ');
-      out += yaml_key(k) + ":";
-      if (t.leaf)
-        out += " " + *t.leaf + "\n";
-      else if (t.kids.empty())
-        out += " {}\n";
-      else {
-        out += "\n";
-        t.emit(out, indent + 2);
-      }
-    }
-  }
-  std::string text() const {
-    std::string s;
-    emit(s, 0);
-    return s;
-  }
-};
+// --- Setting keys ----------------------------------------------------------------------
 
 const std::vector<std::string>& special_keys() {
   static const std::vector<std::string> k = {"dataset", "seed", "configuration",
@@ -140,12 +74,6 @@ const std::vector<std::string>& configuration_choices() {
   static const std::vector<std::string> c = {"single",     "single-right", "dual-wheel",
                                              "body-wheel", "triple",       "centralized"};
   return c;
-}
-
-std::size_t imu_count(const std::string& configuration) {
-  if (configuration == "single" || configuration == "single-right") return 1;
-  if (configuration == "dual-wheel" || configuration == "body-wheel") return 2;
-  return 3;
 }
 
 std::string closest(const std::string& key, const std::vector<std::string>& known) {
@@ -173,93 +101,6 @@ std::optional<std::pair<long long, long long>> parse_range(const std::string& s)
   } catch (const std::exception&) {
     return std::nullopt;
   }
-}
-
-std::string fnv_of_file(const fs::path& p, const std::string& what) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw InputError("'" + p.string() + "': " + what + " not found or unreadable");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return hash_text(ss.str()) + " (" + std::to_string(ss.str().size()) + " bytes)";
-}
-
-std::string slug(std::string s) {
-  for (char& c : s)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
-  return s;
-}
-
-/// The `wheelins simulate` option names that stand for a scenario.yaml key.
-const std::map<std::string, std::string>& sim_alias() {
-  static const std::map<std::string, std::string> a = {{"preset", "vehicle.preset"},
-                                                       {"terrain", "terrain_slope_deg"},
-                                                       {"cruise_speed", "speed_m_s"},
-                                                       {"static", "static_s"},
-                                                       {"radius", "vehicle.wheel_radius_m"},
-                                                       {"track", "vehicle.track_m"},
-                                                       {"rate", "rate_hz"},
-                                                       {"duration", "duration_s"},
-                                                       {"speed", "speed_file"}};
-  return a;
-}
-
-/// Every scalar of `n` by its dotted key.
-void flatten(const YAML::Node& n, const std::string& prefix,
-             std::map<std::string, std::string>& out) {
-  if (n.IsMap()) {
-    for (const auto& kv : n)
-      flatten(kv.second, prefix + (prefix.empty() ? "" : ".") + kv.first.as<std::string>(), out);
-  } else if (n.IsScalar()) {
-    out[prefix] = n.Scalar();
-  }
-}
-
-/// `v` with every reference "${KEY}", "${KEY}*N" or "${KEY}/N" (a whole text value, also
-/// inside lists and maps) replaced by the value `lookup` gives (times or over N).
-YAML::Node substitute(
-    const YAML::Node& v,
-    const std::function<std::string(const std::string&, const std::string&)>& lookup,
-    const std::string& where) {
-  if (v.IsSequence()) {
-    YAML::Node out(YAML::NodeType::Sequence);
-    for (const auto& x : v) out.push_back(substitute(x, lookup, where));
-    return out;
-  }
-  if (v.IsMap()) {
-    YAML::Node out(YAML::NodeType::Map);
-    for (const auto& kv : v) out[kv.first.as<std::string>()] = substitute(kv.second, lookup, where);
-    return out;
-  }
-  if (!v.IsScalar() || v.Scalar().find("${") == std::string::npos) return YAML::Clone(v);
-  // "${KEY}" [*|/ NUMBER], blanks allowed around the parts.
-  const std::string text = v.Scalar();
-  auto bad = [&]() {
-    return InputError(where + ": '" + text +
-                      "': a reference is a whole value: ${KEY}, ${KEY}*N or ${KEY}/N");
-  };
-  auto trim = [](std::string t) {
-    while (!t.empty() && std::isspace(static_cast<unsigned char>(t.front()))) t.erase(t.begin());
-    while (!t.empty() && std::isspace(static_cast<unsigned char>(t.back()))) t.pop_back();
-    return t;
-  };
-  const std::string t = trim(text);
-  const auto close = t.find('}');
-  if (t.rfind("${", 0) != 0 || close == std::string::npos) throw bad();
-  const std::string key = t.substr(2, close - 2);
-  if (key.empty() || !std::all_of(key.begin(), key.end(), [](unsigned char c) {
-        return std::isalnum(c) || c == '_' || c == '.' || c == '-';
-      }))
-    throw bad();
-  const std::string rest = trim(t.substr(close + 1));
-  const std::string value = lookup(key, where);
-  if (rest.empty()) return YAML::Node(value);
-  const char op = rest[0];
-  const auto f = io_detail::parse_double(rest.substr(1));
-  if ((op != '*' && op != '/') || !f) throw bad();
-  const auto x = io_detail::parse_double(value);
-  if (!x)
-    throw InputError(where + ": '" + text + "': " + key + " = '" + value + "' is not a number");
-  return YAML::Node(io_detail::format_double(op == '*' ? *x * *f : *x / *f));
 }
 
 }  // namespace
@@ -290,7 +131,7 @@ RunConfig load_run_yaml(const std::string& run_yaml, const fs::path& manifest,
                                    std::to_string(counter++) + ".yaml");
   {
     std::ofstream out(tmp, std::ios::binary);
-    out << "dataset: " << flow(YAML::Node(manifest.string())) << "\n" << run_yaml;
+    out << "dataset: " << flow_yaml(YAML::Node(manifest.string())) << "\n" << run_yaml;
     if (!out) throw InputError("'" + tmp.string() + "': cannot write a temporary file");
   }
   const std::string quoted = "'" + tmp.string() + "'";
@@ -391,7 +232,9 @@ struct Loader {
     return out;
   }
 
-  static std::string label_of(const YAML::Node& v) { return v.IsScalar() ? v.Scalar() : flow(v); }
+  static std::string label_of(const YAML::Node& v) {
+    return v.IsScalar() ? v.Scalar() : flow_yaml(v);
+  }
 
   /// `key: [values]` (a list axis of one setting) or `name: {label: {settings}, ...}`.
   Axis axis(const std::string& name, const YAML::Node& v, const std::string& where,
@@ -505,7 +348,7 @@ std::string experiment_study_yaml(const ExperimentSpec& e) {
       "results: .\n"
       "experiment:\n"
       "  dataset: " +
-      flow(YAML::Node(e.dataset.string())) + "\n";
+      flow_yaml(YAML::Node(e.dataset.string())) + "\n";
   if (!e.only.empty()) {
     s += "  only: [";
     for (std::size_t i = 0; i < e.only.size(); ++i) s += (i ? ", " : "") + e.only[i];
@@ -694,356 +537,6 @@ std::size_t Study::job_count() const {
   std::size_t n = 1;
   for (const auto& a : axes_) n *= a.values.size();
   return n;
-}
-
-Job Study::job(std::size_t k) const {
-  const std::lock_guard<std::mutex> lock(*mutex_);
-  if (k >= job_count())
-    throw InputError("job " + std::to_string(k) + ": the study '" + file_.string() +
-                     "' has jobs 0.." + std::to_string(job_count() - 1));
-  std::vector<std::size_t> choice(axes_.size());
-  std::vector<Setting> settings = fixed_;
-  if (experiment_) {
-    const eval::ExperimentRun& r = experiment_runs_[k];
-    const std::string c = r.centralized ? "centralized" : r.configuration;
-    const std::string l =
-        r.configuration == "single" ? std::string(r.side == "left" ? "L" : "R") + r.label : r.label;
-    for (std::size_t i = 0; i < axes_[0].values.size(); ++i)
-      if (axes_[0].values[i].label == l) choice[0] = i;
-    for (std::size_t i = 0; i < axes_[1].values.size(); ++i)
-      if (axes_[1].values[i].label == c) choice[1] = i;
-    const std::string w = "experiment";
-    YAML::Node modules(YAML::NodeType::Sequence);
-    for (const auto& m : r.modules) modules.push_back(m);
-    settings.insert(settings.begin(), {"dataset", YAML::Node(experiment_->dataset.string()), w});
-    settings.insert(settings.begin() + 1, {"run.fusion.speed", YAML::Node(experiment_->speed), w});
-    if (experiment_->duration > 0)
-      settings.insert(
-          settings.begin() + 2,
-          {"run.duration_s", YAML::Node(io_detail::format_double(experiment_->duration)), w});
-    settings.push_back({"modules", modules, w});
-    settings.push_back({"run.fusion.centralized", YAML::Node(r.centralized), w});
-    Job j = resolve(k, choice, settings);
-    j.keep_series = r.figure;
-    j.experiment_run = r;
-    j.canonical += "keep_series: " + std::string(r.figure ? "true" : "false") + "\n";
-    j.key = hash_text(j.canonical);
-    return j;
-  }
-  std::size_t rest = k;
-  for (std::size_t i = axes_.size(); i-- > 0;) {
-    choice[i] = rest % axes_[i].values.size();
-    rest /= axes_[i].values.size();
-  }
-  for (std::size_t i = 0; i < axes_.size(); ++i)
-    for (const auto& st : axes_[i].values[choice[i]].settings) settings.push_back(st);
-  return resolve(k, choice, settings);
-}
-
-Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
-                   const std::vector<Setting>& settings) const {
-  Job j;
-  j.index = k;
-  j.choice = choice;
-  for (std::size_t i = 0; i < axes_.size(); ++i)
-    j.labels.push_back(axes_[i].values[choice[i]].label);
-  const std::string who = "'" + file_.string() + "': job " + std::to_string(k);
-  auto rel = [&](const std::string& p) {
-    return (fs::path(p).is_absolute() ? fs::path(p) : fs::absolute(dir_ / p)).lexically_normal();
-  };
-  auto text_of = [&](const Setting& s) {
-    if (!s.value.IsScalar() || s.value.Scalar().empty())
-      throw InputError(who + ": " + s.where + ": " + s.key + ": expected a text value");
-    return s.value.Scalar();
-  };
-  auto list_of = [&](const Setting& s) {
-    std::vector<std::string> out;
-    if (s.value.IsScalar()) {
-      std::stringstream ss(s.value.Scalar());
-      for (std::string item; std::getline(ss, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    } else if (s.value.IsSequence()) {
-      for (const auto& x : s.value) out.push_back(x.as<std::string>());
-    } else {
-      throw InputError(who + ": " + s.where + ": " + s.key + ": expected a list");
-    }
-    return out;
-  };
-
-  std::optional<fs::path> dataset;
-  std::string dataset_where, sim_where;
-  Tree sim_tree, run_tree;
-  std::vector<std::string> sim_configs, sim_sets, faults, disable;
-  std::optional<std::vector<std::string>> only;
-  std::optional<std::string> wheel_noise;
-  std::optional<bool> earth_rotation;
-  std::string edits;
-  std::optional<std::string> configuration, chip;
-  std::vector<const Setting*> later;
-  for (const Setting& s : settings) {
-    if (s.key == "dataset") {
-      dataset = rel(text_of(s));
-      if (fs::is_directory(*dataset)) *dataset /= "manifest.yaml";
-      dataset_where = s.where;
-      continue;
-    }
-    if (s.key == "seed" || s.key.rfind("simulate.", 0) == 0) {
-      sim_where = s.where;
-      std::string key = s.key == "seed" ? "seed" : s.key.substr(9);
-      const std::string first = split_dotted(key)[0];
-      const auto& alias = sim_alias();
-      if (key == "config")
-        sim_configs.push_back(rel(text_of(s)).string());
-      else if (key == "set")
-        for (const auto& a : list_of(s)) sim_sets.push_back(a);
-      else if (key == "only")
-        only = list_of(s);
-      else if (key == "disable")
-        for (const auto& a : list_of(s)) disable.push_back(a);
-      else if (key == "fault" || key == "faults_append")
-        for (const auto& a : list_of(s)) faults.push_back(a);
-      else if (key == "wheel_noise")
-        wheel_noise = text_of(s);
-      else if (key == "no_earth_rotation") {
-        try {
-          earth_rotation = !s.value.as<bool>();
-        } catch (const YAML::Exception&) {
-          throw InputError(who + ": " + s.where +
-                           ": simulate.no_earth_rotation: expected true or false");
-        }
-      } else if (key == "no_ideal" || key == "out" || key == "force" || key == "quiet")
-        throw InputError(who + ": " + s.where + ": simulate." + key +
-                         " is an output choice of `wheelins simulate`, not a setting of the data");
-      else {
-        if (const auto a = alias.find(first); a != alias.end() && key == first) key = a->second;
-        if (key == "scenario" || key == "speed_file") {
-          const std::string p = text_of(s);
-          sim_tree.set(split_dotted(key), 0,
-                       YAML::Node(key == "scenario" && p == "default" ? p : rel(p).string()));
-        } else {
-          sim_tree.set(split_dotted(key), 0, s.value);
-        }
-      }
-      continue;
-    }
-    later.push_back(&s);  // run settings and manifest edits may refer to the data's settings
-  }
-  // The data.
-  DatasetSpec& d = j.dataset;
-  const std::map<std::string, std::string>* sim_values = nullptr;  // dotted key -> value
-  if (dataset && !sim_where.empty())
-    throw InputError(who + ": both a dataset (" + dataset_where + ") and simulator settings (" +
-                     sim_where + "): a job navigates one or the other");
-  if (dataset) {
-    d.manifest = *dataset;
-    d.canonical = "manifest: " + dataset->string() +
-                  "\nmanifest_text: " + fnv_of_file(*dataset, "manifest") + "\n";
-  } else if (!sim_where.empty() || !sim_configs.empty()) {
-    // The same simulator settings give the same data: resolved once per study (a sweep has
-    // many jobs per dataset).
-    std::string memo_key = sim_tree.text() + "\n--";
-    for (const auto* list : {&sim_configs, &sim_sets, &faults, &disable}) {
-      memo_key += "--\n";
-      for (const auto& x : *list) memo_key += x + "\n";
-    }
-    memo_key += "--" + wheel_noise.value_or("-") + "\n";
-    if (only)
-      for (const auto& x : *only) memo_key += "only " + x + "\n";
-    if (earth_rotation) memo_key += *earth_rotation ? "earth\n" : "no earth\n";
-    auto& memo = *sim_memo_;
-    if (const auto it = memo.find(memo_key); it != memo.end()) {
-      d = it->second.data;
-      sim_values = &it->second.values;
-    } else {
-      sim::SimConfig c;
-      c.write_ideal = false;  // the cache keeps the data a filter reads, not the error-free streams
-      const std::string where = who + ": simulator settings";
-      for (const auto& f : sim_configs) {
-        YAML::Node node;
-        try {
-          node = YAML::LoadFile(f);
-        } catch (const YAML::Exception& e) {
-          throw InputError(where + ": '" + f + "': " + e.what());
-        }
-        c.apply_yaml(node, where + " ('" + f + "')");
-      }
-      if (!sim_tree.kids.empty()) {
-        YAML::Node node;
-        try {
-          node = YAML::Load(sim_tree.text());
-        } catch (const YAML::Exception& e) {
-          throw InputError(where + ": " + e.what());
-        }
-        c.apply_yaml(node, where);
-      }
-      try {
-        for (const auto& a : sim_sets) c.apply_setting(a);
-        if (wheel_noise) {
-          c.apply_setting("errors.wheel_accel_noise_m_s_sqrt_h=" + *wheel_noise);
-          c.effects.insert("wheel_noise");
-        }
-        for (const auto& f : faults) c.faults.push_back(sim::parse_fault_spec(f));
-        if (only) c.only(*only);
-        c.disable(disable);
-        if (earth_rotation) c.earth_rotation = *earth_rotation;
-      } catch (const InputError& e) {
-        throw InputError(where + ": " + e.what());
-      }
-      d.canonical = "wheelins study dataset 1\n" + c.to_yaml();
-      if (c.scenario != "default")
-        d.canonical += "scenario_file: " + fnv_of_file(c.scenario, "scenario file") + "\n";
-      if (c.speed_file)
-        d.canonical += "speed_file: " + fnv_of_file(*c.speed_file, "speed file") + "\n";
-      d.cache_name = slug(c.vehicle.preset + "-" + c.profile + "-seed" + std::to_string(c.seed)) +
-                     "-" + hash_text(d.canonical);
-      d.sim = std::move(c);
-      if (memo.size() > 100000) memo.clear();
-      SimMemo& m = memo[memo_key];
-      m.data = d;
-      flatten(YAML::Load(d.sim->to_yaml()), "", m.values);
-      sim_values = &m.values;
-    }
-  } else {
-    throw InputError(who +
-                     ": no data: give `dataset: MANIFEST` or simulator settings (`simulate:`)");
-  }
-  // Run settings and manifest edits, with references to the data's settings resolved.
-  auto lookup = [&](const std::string& ref, const std::string& where) -> std::string {
-    std::string key = ref == "seed" ? "simulate.seed" : ref;
-    if (key.rfind("simulate.", 0) != 0)
-      throw InputError(who + ": " + where + ": ${" + ref +
-                       "}: only the data's settings can be referred to (simulate.KEY or seed)");
-    if (!d.sim)
-      throw InputError(who + ": " + where + ": ${" + ref + "}: the job's data are not simulated");
-    key = key.substr(9);
-    if (const auto a = sim_alias().find(key); a != sim_alias().end()) key = a->second;
-    if (key == "wheel_noise") key = "errors.wheel_accel_noise_m_s_sqrt_h";
-    const auto it = sim_values->find(key);
-    if (it == sim_values->end())
-      throw InputError(who + ": " + where + ": ${" + ref +
-                       "}: no such simulator setting (a single value)");
-    return it->second;
-  };
-  for (const Setting* sp : later) {
-    const Setting& s0 = *sp;
-    const Setting s{s0.key, substitute(s0.value, lookup, s0.where), s0.where};
-    if (s.key.rfind("run.", 0) == 0) {
-      const std::string key = s.key.substr(4);
-      if (key == "dataset")
-        throw InputError(who + ": " + s.where +
-                         ": run.dataset: give the data with `dataset` or `simulate`");
-      run_tree.set(split_dotted(key), 0, s.value);
-    } else if (s.key.rfind("manifest.", 0) == 0) {
-      edits += "- " + yaml_key(s.key.substr(9)) + ": " + flow(s.value) + "\n";
-    } else if (s.key == "configuration") {
-      configuration = text_of(s);
-    } else if (s.key == "chip") {
-      chip = text_of(s);
-    } else if (s.key == "chips" || s.key == "modules") {
-      YAML::Node seq(YAML::NodeType::Sequence);
-      for (const auto& c : list_of(s)) seq.push_back(c);
-      run_tree.set({s.key}, 0, seq);
-    } else {
-      throw InputError(who + ": " + s.where + ": unknown setting '" + s.key + "'");
-    }
-  }
-  if (const Tree* out = run_tree.find("output")) {
-    if (out->leaf)
-      throw InputError(who + ": run.output: expected a map (only output.interval_s applies)");
-    for (const auto& kv : out->kids)
-      if (kv.first != "interval_s")
-        throw InputError(who + ": run.output." + kv.first +
-                         ": a study writes no trajectories (only output.interval_s applies)");
-  }
-
-  d.manifest_edits = edits;
-  // Edits of a manifest that is not ours go into the cache (the data stay where they are).
-  if (d.manifest && !edits.empty())
-    d.cache_name = "edited-" + slug(d.manifest->parent_path().filename().string()) + "-" +
-                   hash_text(d.canonical + edits);
-
-  // The run configuration.
-  std::string cfg = configuration.value_or("");
-  if (cfg.empty()) {
-    if (const Tree* t = run_tree.find("configuration"); t && t->leaf)
-      cfg = YAML::Load(*t->leaf).as<std::string>();
-  }
-  if (cfg == "centralized") {
-    run_tree.set({"configuration"}, 0, YAML::Node("triple"));
-    run_tree.set({"fusion", "centralized"}, 0, YAML::Node(true));
-  } else if (configuration) {
-    run_tree.set({"configuration"}, 0, YAML::Node(cfg));
-  }
-  if (chip) {
-    YAML::Node seq(YAML::NodeType::Sequence);
-    for (std::size_t i = 0; i < imu_count(cfg.empty() ? "single" : cfg); ++i) seq.push_back(*chip);
-    run_tree.set({"chips"}, 0, seq);
-  }
-  if (!run_tree.has({"output", "interval_s"}))
-    run_tree.set({"output", "interval_s"}, 0, YAML::Node("0.05"));
-  j.run_yaml = run_tree.text();
-  j.configuration = cfg.empty() ? "single" : cfg;
-  for (std::size_t i = 0; i < axes_.size(); ++i)
-    if (axes_[i].role == AxisRole::kConfiguration) j.configuration = j.labels[i];
-  j.canonical = d.canonical + (edits.empty() ? "" : "--- manifest edits\n" + edits) + "--- run\n" +
-                j.run_yaml;
-  j.key = hash_text(j.canonical);
-  return j;
-}
-
-std::vector<std::size_t> Study::data_siblings(std::size_t k) const {
-  if (experiment_) return {k};
-  auto changes_data = [](const Axis& a) {
-    for (const auto& v : a.values)
-      for (const auto& st : v.settings)
-        if (st.key == "dataset" || st.key == "seed" || st.key.rfind("simulate.", 0) == 0)
-          return true;
-    return false;
-  };
-  std::vector<std::size_t> choice(axes_.size());
-  std::size_t rest = k;
-  for (std::size_t i = axes_.size(); i-- > 0;) {
-    choice[i] = rest % axes_[i].values.size();
-    rest /= axes_[i].values.size();
-  }
-  std::vector<std::size_t> free;
-  for (std::size_t i = 0; i < axes_.size(); ++i)
-    if (!changes_data(axes_[i])) free.push_back(i);
-  std::vector<std::size_t> out;
-  // Every combination of the free axes, the others as in job k.
-  for (std::size_t a : free) choice[a] = 0;
-  for (bool more = true; more;) {
-    std::size_t index = 0;
-    for (std::size_t i = 0; i < axes_.size(); ++i)
-      index = index * axes_[i].values.size() + choice[i];
-    out.push_back(index);
-    more = false;
-    for (std::size_t f = free.size(); f-- > 0;) {
-      const std::size_t a = free[f];
-      if (++choice[a] < axes_[a].values.size()) {
-        more = true;
-        break;
-      }
-      choice[a] = 0;
-    }
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-std::vector<Job> Study::check_all() const {
-  std::vector<Job> jobs;
-  const std::size_t n = job_count();
-  jobs.reserve(n);
-  std::set<std::string> checked;
-  for (std::size_t k = 0; k < n; ++k) {
-    jobs.push_back(job(k));
-    const Job& j = jobs.back();
-    if (checked.insert(j.run_yaml).second)
-      check_run_yaml(j.run_yaml, "'" + file_.string() + "': run settings of job " +
-                                     std::to_string(k) + " (" + j.describe() + ")");
-  }
-  return jobs;
 }
 
 }  // namespace wheelins::study

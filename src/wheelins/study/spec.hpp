@@ -179,4 +179,7 @@ std::vector<std::string> split_dotted(const std::string& key);
 /// FNV-1a 64 of `text` as 16 hex digits.
 std::string hash_text(const std::string& text);
 
+/// A YAML value as one line of flow-style YAML ("null" when undefined or null).
+std::string flow_yaml(const YAML::Node& value);
+
 }  // namespace wheelins::study
