@@ -1,0 +1,519 @@
+// ROS recordings in: bags made here from a simulated dataset (ROS 1 with the ROS bag
+// storage library, ROS 2 sqlite3 and MCAP with the test-side writers of tests/ros/)
+// import to the simulated files, and a run on the imported dataset gives the run on the
+// original; bad recordings give InputErrors naming file, topic and message.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "ros/bag_writers.hpp"
+#include "wheelins/io/binary.hpp"
+#include "wheelins/io/manifest.hpp"
+#include "wheelins/io/ros/cdr.hpp"
+#include "wheelins/io/ros/import.hpp"
+#include "wheelins/io/ros/mcap.hpp"
+#include "wheelins/io/truth.hpp"
+#include "wheelins/run/presets.hpp"
+#include "wheelins/run/run.hpp"
+#include "wheelins/sim/simulator.hpp"
+
+using namespace wheelins;
+using namespace wheelins::test_ros;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("wheelins_test_ros_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(p);
+  return p;
+}
+
+std::vector<std::vector<double>> rows(const fs::path& f, int ncols) {
+  BinaryRowReader r(f, ncols);
+  std::vector<std::vector<double>> out;
+  while (const double* v = r.next()) out.emplace_back(v, v + ncols);
+  return out;
+}
+
+ros::Stamp stamp_ns(std::int64_t ns) {
+  return ros::Stamp{ns / 1000000000, static_cast<std::uint32_t>(ns % 1000000000)};
+}
+std::int64_t ns_of(double t) { return std::llround(t * 1e9); }
+
+const Mat3 kEnuToNed = (Mat3() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
+const Mat3 kFrdToFlu = Vec3(1, -1, -1).asDiagonal();
+
+std::array<double, 4> xyzw(const Quat& q) { return {q.x(), q.y(), q.z(), q.w()}; }
+
+struct Topic {
+  std::string module, topic, frame;
+};
+const std::vector<Topic> kTopics = {{"left-C1", "/left_wheel/imu", "left_wheel_imu"},
+                                    {"right-C1", "/right_wheel/imu", "right_wheel_imu"},
+                                    {"body-C1", "/body/imu", "body_imu"}};
+constexpr std::int64_t kReceiveDelay = 1000000;  // receive = stamp + 1 ms
+
+class RosImport : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dataset_ = new fs::path(scratch("sim"));
+    sim::SimConfig cfg;
+    cfg.static_duration = 2.0;
+    cfg.duration = 10.0;
+    cfg.loop_scale = 0.25;
+    cfg.path_sigma = 1.5;
+    cfg.chips = 1;
+    cfg.write_ideal = false;
+    sim::Simulation(cfg).write(*dataset_, false, false);
+    manifest_ = new Manifest(load_manifest(*dataset_ / "manifest.yaml", {}));
+    msgs_ = new std::vector<OutMessage>(messages(*manifest_));
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(*dataset_, ec);
+    delete dataset_;
+    delete manifest_;
+    delete msgs_;
+  }
+
+  /// The dataset as ROS messages in receive-time order: the IMUs, the truth as
+  /// nav_msgs/Odometry in ENU/FLU about the manifest's origin, the odometer speed, and
+  /// /tf_static with the modules' positions.
+  static std::vector<OutMessage> messages(const Manifest& m) {
+    std::vector<OutMessage> out;
+    for (const Topic& t : kTopics) {
+      for (const auto& r : rows(m.resolve(m.find(t.module)->file), 7)) {
+        OutMessage o;
+        o.topic = t.topic;
+        o.kind = ros::MessageKind::kImu;
+        o.imu.stamp = stamp_ns(ns_of(r[0]));
+        o.receive_ns = o.imu.stamp.ns() + kReceiveDelay;
+        o.imu.frame_id = t.frame;
+        o.imu.gyro = {r[1], r[2], r[3]};
+        o.imu.accel = {r[4], r[5], r[6]};
+        out.push_back(o);
+      }
+    }
+    const earth::LocalFrame frame(m.origin);
+    TruthReader truth(m.resolve(*m.truth_file));
+    TruthRecord tr;
+    while (truth.next(tr)) {
+      OutMessage o;
+      o.topic = "/ground_truth/odom";
+      o.kind = ros::MessageKind::kOdometry;
+      o.pose.stamp = stamp_ns(ns_of(tr.t));
+      o.receive_ns = o.pose.stamp.ns() + kReceiveDelay;
+      o.pose.frame_id = "map";
+      o.pose.child_frame_id = "base_link";
+      const Vec3 p_enu = kEnuToNed * frame.ned_from_geodetic(tr.lla);
+      const Mat3 C_flu_enu = kEnuToNed * dcm_from_euler(tr.rpy) * kFrdToFlu;
+      o.pose.position = {p_enu.x(), p_enu.y(), p_enu.z()};
+      o.pose.orientation = xyzw(Quat(C_flu_enu));
+      const Vec3 v_flu = C_flu_enu.transpose() * (kEnuToNed * tr.v_ned);
+      o.pose.linear = {v_flu.x(), v_flu.y(), v_flu.z()};
+      o.pose.has_twist = true;
+      out.push_back(o);
+    }
+    for (const auto& r : rows(m.resolve(*m.odometer_file), 2)) {
+      OutMessage o;
+      o.topic = "/odom";
+      o.kind = ros::MessageKind::kOdometry;
+      o.pose.stamp = stamp_ns(ns_of(r[0]));
+      o.receive_ns = o.pose.stamp.ns() + kReceiveDelay;
+      o.pose.frame_id = "odom";
+      o.pose.child_frame_id = "base_link";
+      o.pose.linear = {r[1], 0.0, 0.0};
+      o.pose.has_twist = true;
+      out.push_back(o);
+    }
+    // In receive-time order, ties in the order made. (No std::stable_sort: its buffer comes
+    // from the nothrow operator new, which the allocation-counting replacement of
+    // test_io_imu_file.cpp does not replace, and ASan reports the mismatched delete.)
+    std::vector<std::size_t> order(out.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return out[a].receive_ns != out[b].receive_ns ? out[a].receive_ns < out[b].receive_ns : a < b;
+    });
+    std::vector<OutMessage> sorted;
+    sorted.reserve(out.size());
+    for (std::size_t k : order) sorted.push_back(std::move(out[k]));
+    out = std::move(sorted);
+    OutMessage tf;
+    tf.topic = "/tf_static";
+    tf.kind = ros::MessageKind::kTf;
+    tf.receive_ns = out.front().receive_ns;
+    for (const Topic& t : kTopics) {
+      ros::Transform x;
+      x.stamp = stamp_ns(tf.receive_ns);
+      x.parent = "base_link";
+      x.child = t.frame;
+      const Vec3 p = kFrdToFlu * m.find(t.module)->p_inV;
+      x.translation = {p.x(), p.y(), p.z()};
+      tf.tf.push_back(x);
+    }
+    out.insert(out.begin(), tf);
+    return out;
+  }
+
+  static ros::ImportOptions options(bool named = true) {
+    ros::ImportOptions o;
+    if (named)
+      for (const Topic& t : kTopics) o.topics.push_back({t.module, t.topic});
+    o.truth_topic = "/ground_truth/odom";
+    o.odometry_topic = "/odom";
+    o.origin = manifest_->origin;
+    return o;
+  }
+
+  /// Imports `recording` and checks every file against the simulated one.
+  static fs::path import_and_compare(const fs::path& recording, const std::string& name) {
+    const fs::path out = scratch(name + "_out");
+    compare(recording, name, out);
+    return out;
+  }
+  static void compare(const fs::path& recording, const std::string& name, const fs::path& out) {
+    const ros::ImportResult r = ros::import_recording(recording, out, options());
+    EXPECT_EQ(r.imu.size(), 3u);
+    const Manifest& m = *manifest_;
+    for (const Topic& t : kTopics) {
+      SCOPED_TRACE(name + " " + t.module);
+      const auto a = rows(m.resolve(m.find(t.module)->file), 7);
+      const auto b = rows(out / (t.module + "_imu.bin"), 7);
+      ASSERT_EQ(a.size(), b.size());
+      double dt = 0.0;
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        dt = std::max(dt, std::abs(a[k][0] - b[k][0]));
+        for (int c = 1; c < 7; ++c) ASSERT_EQ(std::memcmp(&a[k][c], &b[k][c], 8), 0) << "row " << k << " col " << c;
+      }
+      EXPECT_LE(dt, 1e-9);
+    }
+    {
+      const auto a = rows(m.resolve(*m.odometer_file), 2), b = rows(out / "odo.bin", 2);
+      ASSERT_EQ(a.size(), b.size());
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        EXPECT_LE(std::abs(a[k][0] - b[k][0]), 1e-9);
+        EXPECT_EQ(a[k][1], b[k][1]);
+      }
+    }
+    {
+      const TruthData a = read_truth(m.resolve(*m.truth_file)), b = read_truth(out / "GINS.bin");
+      ASSERT_EQ(a.records.size(), b.records.size());
+      double dpos = 0, dvel = 0, datt = 0, dtime = 0;
+      for (std::size_t k = 0; k < a.records.size(); ++k) {
+        const auto &x = a.records[k], &y = b.records[k];
+        dtime = std::max(dtime, std::abs(x.t - y.t));
+        dpos = std::max({dpos, std::abs(x.lla.lat - y.lla.lat) * 6.4e6, std::abs(x.lla.lon - y.lla.lon) * 6.4e6,
+                         std::abs(x.lla.h - y.lla.h)});
+        dvel = std::max(dvel, (x.v_ned - y.v_ned).norm());
+        for (int i = 0; i < 3; ++i) datt = std::max(datt, std::abs(wrap_pi(x.rpy[i] - y.rpy[i])));
+      }
+      EXPECT_LE(dtime, 1e-9);
+      EXPECT_LE(dpos, 1e-6);   // [m]: the local ENU round trip
+      EXPECT_LE(dvel, 1e-12);  // [m/s]
+      EXPECT_LE(datt, 1e-12);  // [rad]
+    }
+    // The drafted manifest: modules named as asked, positions from /tf_static, kinds by name.
+    const Manifest d = load_manifest(out / "manifest.yaml", {});
+    EXPECT_EQ(d.modules.size(), 3u);
+    for (const Topic& t : kTopics) {
+      const ModuleSpec* s = d.find(t.module);
+      ASSERT_NE(s, nullptr) << t.module;
+      EXPECT_LE((s->p_inV - m.find(t.module)->p_inV).norm(), 1e-12) << t.module;
+      EXPECT_EQ(s->kind, t.module == "body-C1" ? ModuleKind::kBody : ModuleKind::kWheel);
+      EXPECT_EQ(s->rate_hz, 200.0);
+    }
+    EXPECT_TRUE(d.truth_file && d.odometer_file);
+  }
+
+  /// Triple INS on a manifest, in memory: every vehicle record.
+  static std::vector<TrajectoryRecord> navigate(const Manifest& m) {
+    RunRequest r;
+    r.manifest = m;
+    r.modules = configuration_modules(m, "triple", {});
+    r.nav.earth_rotation = m.earth_rotation;
+    r.nav.module_records = false;
+    r.progress = false;
+    std::vector<TrajectoryRecord> recs;
+    r.on_record = [&](const TrajectoryRecord& rec) { recs.push_back(rec); };
+    run_navigation(r);
+    return recs;
+  }
+
+  static std::string bytes(const fs::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+
+  static fs::path* dataset_;
+  static Manifest* manifest_;
+  static std::vector<OutMessage>* msgs_;
+};
+fs::path* RosImport::dataset_ = nullptr;
+Manifest* RosImport::manifest_ = nullptr;
+std::vector<OutMessage>* RosImport::msgs_ = nullptr;
+
+// The done-when of the import: the three formats give the simulated files, the same bytes
+// from each, and a run on the imported dataset gives the run on the original.
+TEST_F(RosImport, ThreeFormatsImportToTheSimulatedFilesAndRunAlike) {
+  const fs::path dir = scratch("bags");
+  fs::create_directories(dir);
+  write_ros1_bag(dir / "sim.bag", *msgs_, "lz4");
+  write_ros2_db3(dir / "sim.db3", *msgs_);
+  write_ros2_mcap(dir / "sim.mcap", *msgs_);
+  const fs::path a = import_and_compare(dir / "sim.bag", "ros1");
+  const fs::path b = import_and_compare(dir / "sim.db3", "db3");
+  const fs::path c = import_and_compare(dir / "sim.mcap", "mcap");
+  for (const char* f : {"left-C1_imu.bin", "right-C1_imu.bin", "body-C1_imu.bin", "GINS.bin", "odo.bin"}) {
+    EXPECT_EQ(bytes(a / f), bytes(b / f)) << f;
+    EXPECT_EQ(bytes(a / f), bytes(c / f)) << f;
+  }
+
+  // The original manifest with the imported files: the same trajectory.
+  Manifest imported = *manifest_;
+  for (ModuleSpec& s : imported.modules)
+    if (fs::exists(a / (s.name + "_imu.bin"))) s.file = a / (s.name + "_imu.bin");
+  imported.truth_file = a / "GINS.bin";
+  imported.odometer_file = a / "odo.bin";
+  const auto x = navigate(*manifest_), y = navigate(imported);
+  ASSERT_EQ(x.size(), y.size());
+  ASSERT_GT(x.size(), 1000u);
+  // The simulated times (start + k / rate) are the doubles nearest to their nanosecond
+  // stamps, so they come back bit-exact, and so does the whole run.
+  bool same_times = true;
+  for (const Topic& t : kTopics) {
+    const auto p = rows(manifest_->resolve(manifest_->find(t.module)->file), 7), q = rows(a / (t.module + "_imu.bin"), 7);
+    for (std::size_t k = 0; k < p.size(); ++k) same_times = same_times && p[k][0] == q[k][0];
+  }
+  EXPECT_TRUE(same_times);
+  double dp = 0, dh = 0, dt = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    dt = std::max(dt, std::abs(x[k].t - y[k].t));
+    dp = std::max(dp, (x[k].p_inN - y[k].p_inN).norm());
+    dh = std::max(dh, std::abs(wrap_pi(x[k].rpy.z() - y[k].rpy.z())));
+  }
+  RecordProperty("max_position_difference_m", std::to_string(dp));
+  std::printf("run on the imported dataset vs the original: max |dt| %.3g s, |dp| %.3g m, |dheading| %.3g rad\n",
+              dt, dp, dh);
+  EXPECT_LE(dt, same_times ? 0.0 : 1e-9);
+  EXPECT_LE(dp, same_times ? 0.0 : 1e-6);
+  EXPECT_LE(dh, same_times ? 0.0 : 1e-9);
+  for (const auto& p : {a, b, c, dir}) fs::remove_all(p);
+}
+
+// The other MCAP shapes (lz4, uncompressed chunks, no chunks), big-endian CDR, an ROS 2 bag
+// directory, and the default module names (after the topics) with receive times.
+TEST_F(RosImport, McapVariantsBigEndianCdrBagDirectoryAndTopicNames) {
+  const fs::path dir = scratch("variants");
+  fs::create_directories(dir / "bag2");
+  write_ros2_mcap(dir / "lz4.mcap", *msgs_, {"lz4", 300, true, true});
+  write_ros2_mcap(dir / "plain.mcap", *msgs_, {"", 700, false, true});
+  write_ros2_mcap(dir / "nochunk.mcap", *msgs_, {"", 0, false, true});
+  write_ros2_db3(dir / "bag2" / "bag2_0.db3", *msgs_, true);
+  std::ofstream(dir / "bag2" / "metadata.yaml") << "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n";
+  for (const fs::path& rec : {dir / "lz4.mcap", dir / "plain.mcap", dir / "nochunk.mcap", dir / "bag2"})
+    fs::remove_all(import_and_compare(rec, rec.stem().string()));
+
+  ros::ImportOptions o = options(false);
+  o.receive_time = true;
+  const fs::path out = scratch("names");
+  const ros::ImportResult r = ros::import_recording(dir / "lz4.mcap", out, o);
+  ASSERT_EQ(r.imu.size(), 3u);
+  const Manifest d = load_manifest(out / "manifest.yaml", {});
+  for (const char* name : {"left_wheel_imu", "right_wheel_imu", "body_imu"}) EXPECT_NE(d.find(name), nullptr) << name;
+  EXPECT_EQ(d.find("body_imu")->kind, ModuleKind::kBody);
+  const auto a = rows(manifest_->resolve(manifest_->find("left-C1")->file), 7);
+  const auto b = rows(out / "left_wheel_imu_imu.bin", 7);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(b[k][0] - a[k][0], 1e-3, 1e-9);
+  fs::remove_all(out);
+  fs::remove_all(dir);
+}
+
+// --- bad input -----------------------------------------------------------------------
+
+/// Twenty IMU messages on /imu and five Odometry messages on /odom.
+std::vector<OutMessage> small_bag() {
+  std::vector<OutMessage> v;
+  for (int k = 0; k < 20; ++k) {
+    OutMessage o;
+    o.topic = "/imu";
+    o.imu.stamp = stamp_ns(100000000000 + 5000000LL * k);
+    o.receive_ns = o.imu.stamp.ns() + 1000;
+    o.imu.frame_id = "imu";
+    o.imu.gyro = {0.01 * k, 0.0, 0.0};
+    o.imu.accel = {0.0, 0.0, -9.8};
+    v.push_back(o);
+    if (k % 4 == 0) {
+      OutMessage d;
+      d.topic = "/odom";
+      d.kind = ros::MessageKind::kOdometry;
+      d.pose.stamp = o.imu.stamp;
+      d.receive_ns = o.receive_ns;
+      d.pose.has_twist = true;
+      v.push_back(d);
+    }
+  }
+  return v;
+}
+
+std::string import_error(const fs::path& rec, const ros::ImportOptions& o = {}) {
+  const fs::path out = scratch("bad_out");
+  std::string what;
+  try {
+    ros::import_recording(rec, out, o);
+  } catch (const InputError& e) {
+    what = e.what();
+  }
+  // All or nothing: a failed import leaves no data files.
+  std::error_code ec;
+  if (fs::exists(out))
+    for (const auto& e : fs::directory_iterator(out, ec)) ADD_FAILURE() << "left behind: " << e.path();
+  fs::remove_all(out, ec);
+  return what;
+}
+
+using Writer = void (*)(const fs::path&, const std::vector<OutMessage>&);
+void ros1(const fs::path& f, const std::vector<OutMessage>& m) { write_ros1_bag(f, m); }
+void db3(const fs::path& f, const std::vector<OutMessage>& m) { write_ros2_db3(f, m); }
+void mcap(const fs::path& f, const std::vector<OutMessage>& m) { write_ros2_mcap(f, m); }
+const std::vector<std::pair<const char*, Writer>> kFormats = {{"bag", ros1}, {"db3", db3}, {"mcap", mcap}};
+
+TEST(RosImportErrors, BadMessagesNameFileTopicAndIndex) {
+  const fs::path dir = scratch("badmsg");
+  fs::create_directories(dir);
+  for (const auto& [ext, write] : kFormats) {
+    SCOPED_TRACE(ext);
+    const fs::path f = dir / (std::string("x.") + ext);
+    auto m = small_bag();
+    // A zero header stamp is reported (with the option to use the receive time), not replaced.
+    m[7].imu.stamp = {};  // m: /imu 0, /odom 0, /imu 1, 2, 3, 4, /odom 1, /imu 5
+    ASSERT_EQ(m[7].topic, "/imu");
+    write(f, m);
+    std::string e = import_error(f);
+    EXPECT_NE(e.find(f.string()), std::string::npos) << e;
+    EXPECT_NE(e.find("topic '/imu', message 5 (0-based): header stamp is zero"), std::string::npos) << e;
+    ros::ImportOptions rt;
+    rt.receive_time = true;
+    const fs::path out = scratch("rt_out");
+    EXPECT_NO_THROW(ros::import_recording(f, out, rt));
+    fs::remove_all(out);
+
+    m = small_bag();
+    m[7].imu.stamp = m[4].imu.stamp;  // /imu message 5 stamped as message 3
+    write(f, m);
+    e = import_error(f);
+    EXPECT_NE(e.find("topic '/imu', message 5 (0-based): header stamp"), std::string::npos) << e;
+    EXPECT_NE(e.find("goes back"), std::string::npos) << e;
+
+    m = small_bag();
+    m[7].imu.accel[1] = std::nan("");
+    write(f, m);
+    e = import_error(f);
+    EXPECT_NE(e.find("topic '/imu', message 5 (0-based): linear_acceleration.y is NaN"), std::string::npos) << e;
+
+    // Wrong types, unknown topics.
+    write(f, small_bag());
+    ros::ImportOptions o;
+    o.topics = {{"imu", "/odom"}};
+    e = import_error(f, o);
+    EXPECT_NE(e.find("topic '/odom' has type"), std::string::npos) << e;
+    EXPECT_NE(e.find("expected sensor_msgs/Imu"), std::string::npos) << e;
+    o.topics = {{"imu", "/nothere"}};
+    e = import_error(f, o);
+    EXPECT_NE(e.find("--topic '/nothere': no such topic; the recording has: "), std::string::npos) << e;
+    o.topics.clear();
+    o.truth_topic = "/imu";
+    e = import_error(f, o);
+    EXPECT_NE(e.find("--truth topic '/imu' has type"), std::string::npos) << e;
+
+    // Truncated: the last third cut off.
+    const auto size = fs::file_size(f);
+    fs::resize_file(f, size * 2 / 3);
+    e = import_error(f);
+    EXPECT_NE(e.find(f.string()), std::string::npos) << e;
+    EXPECT_FALSE(e.empty());
+  }
+  fs::remove_all(dir);
+}
+
+TEST(RosImportErrors, CorruptRos2Payloads) {
+  const fs::path dir = scratch("corrupt");
+  fs::create_directories(dir);
+  // A CDR payload cut short (written into the sqlite3 bag as it is).
+  {
+    auto m = small_bag();
+    write_ros2_db3(dir / "x.db3", m);
+    // Row 5 is /imu message 3 (rows: /imu 0, /odom 0, /imu 1, 2, 3): cut to 60 bytes.
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir / "x.db3").c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "UPDATE messages SET data = substr(data, 1, 60) WHERE id = 5", nullptr, nullptr,
+                           nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+    const std::string e = import_error(dir / "x.db3");
+    EXPECT_NE(e.find("topic '/imu' (sensor_msgs/msg/Imu), message 3 (0-based): CDR payload ends at byte 60"),
+              std::string::npos)
+        << e;
+  }
+  // MCAP: a flipped byte inside a compressed chunk (CRC or decompression fails), and a file
+  // without its DataEnd / Footer.
+  {
+    write_ros2_mcap(dir / "x.mcap", small_bag(), {"", 10, true, true});
+    std::string b;
+    {
+      std::ifstream in(dir / "x.mcap", std::ios::binary);
+      std::stringstream ss;
+      ss << in.rdbuf();
+      b = ss.str();
+    }
+    b[b.size() / 2] ^= 0x40;
+    std::ofstream(dir / "y.mcap", std::ios::binary) << b;
+    std::string e = import_error(dir / "y.mcap");
+    EXPECT_NE(e.find("Chunk CRC-32 does not match"), std::string::npos) << e;
+    write_ros2_mcap(dir / "z.mcap", small_bag(), {"zstd", 10, true, false});
+    e = import_error(dir / "z.mcap");
+    EXPECT_NE(e.find("without a DataEnd or Footer record (truncated"), std::string::npos) << e;
+  }
+  // Not a recording at all.
+  std::ofstream(dir / "notes.txt") << "hello";
+  EXPECT_NE(import_error(dir / "notes.txt").find("not a ROS recording"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// The CDR decoder against hand-made payloads: alignment, both byte orders, bounds.
+TEST(RosCdr, DecodesAlignedFieldsInBothByteOrdersAndRejectsShortData) {
+  OutMessage m;
+  m.imu.stamp = {12, 345};
+  m.imu.gyro = {1.5, -2.25, 3e-9};
+  m.imu.accel = {0.0, -0.0, 9.80665};
+  // "abc" + NUL ends the string at byte 16 after the header: the orientation follows
+  // without padding; "abcdefg" + NUL ends at 20: 4 bytes of padding to the next 8.
+  for (const auto& [frame, pad] : {std::pair<std::string, std::size_t>{"abc", 0}, {"abcdefg", 4}})
+  for (bool big : {false, true}) {
+    m.imu.frame_id = frame;
+    const auto p = cdr_payload(m, big);
+    EXPECT_EQ(p.size(), 4u + 8 + 4 + frame.size() + 1 + pad + 32 + 72 + 24 + 72 + 24 + 72);
+    const ros::ImuMessage d = ros::decode_imu(p.data(), p.size());
+    EXPECT_EQ(d.stamp.sec, 12);
+    EXPECT_EQ(d.stamp.nsec, 345u);
+    EXPECT_EQ(d.frame_id, frame);
+    EXPECT_EQ(d.gyro, m.imu.gyro);
+    EXPECT_EQ(d.accel, m.imu.accel);
+    for (std::size_t cut : {std::size_t(0), std::size_t(3), std::size_t(10), p.size() - 1})
+      EXPECT_THROW(ros::decode_imu(p.data(), cut), ros::CdrError) << cut;
+  }
+  std::vector<std::uint8_t> bad = {0x00, 0x06, 0, 0, 0, 0, 0, 0};
+  EXPECT_THROW(ros::decode_imu(bad.data(), bad.size()), ros::CdrError);
+  EXPECT_EQ(ros::crc32(reinterpret_cast<const std::uint8_t*>("123456789"), 9), 0xCBF43926u);
+}
+
+}  // namespace
