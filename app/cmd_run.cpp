@@ -2,13 +2,12 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
 
 #include "cli.hpp"
-#include "wheelins/eval/metrics.hpp"
+#include "wheelins/eval/run_evaluation.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
@@ -100,45 +99,16 @@ int run(const RunArgs& a) {
   RunRequest req = make_run_request(cfg, stderr_sink());
   req.progress = !a.quiet;
 
-  // Evaluation against the truth as the run goes: the truth file is streamed in step with
-  // the vehicle solution (taken at 20 Hz), so memory stays flat however long the data.
+  // Evaluation against the truth as the run goes (eval/run_evaluation.hpp): a truth file
+  // that cannot be opened stops the command before the run; a bad record met later is
+  // reported after the trajectory is written.
   const bool evaluate = req.manifest.truth_file && !a.no_evaluate;
-  std::unique_ptr<TruthReader> truth;
-  std::unique_ptr<eval::Evaluator> evaluator;
-  TruthRecord next_truth;
-  bool have_next_truth = false;
-  // A truth file that cannot be opened, or whose first record is bad, stops the command
-  // before the run (nothing written yet); a bad record met later is reported after the
-  // trajectory is written (eval_error).
-  std::string eval_error;
+  std::unique_ptr<eval::RunEvaluation> evaluation;
   if (evaluate) {
-    truth = std::make_unique<TruthReader>(req.manifest.resolve(*req.manifest.truth_file));
-    eval::Evaluator::Sources src;
-    src.truth_file = truth->file().string();
-    src.traj_file = "the run's vehicle solution";
-    src.traj_format = "memory";
-    src.truth_has_attitude = truth->has_velocity_attitude();
-    evaluator = std::make_unique<eval::Evaluator>(earth::LocalFrame(req.manifest.origin), src,
-                                                  eval::EvalOptions{}, false);
-    have_next_truth = truth->next(next_truth);
+    evaluation = std::make_unique<eval::RunEvaluation>(req.manifest.resolve(*req.manifest.truth_file),
+                                                       req.manifest.origin);
+    req.on_record = [&](const TrajectoryRecord& r) { evaluation->add(r); };
   }
-  double next_keep = -1e300;
-  auto feed_truth_before = [&](double t) {
-    while (have_next_truth && next_truth.t < t) {
-      evaluator->add_truth(next_truth);
-      have_next_truth = truth->next(next_truth);
-    }
-  };
-  if (evaluate) req.on_record = [&](const TrajectoryRecord& r) {
-    if (!eval_error.empty() || r.t + 1e-9 < next_keep) return;
-    next_keep = r.t + 0.05;
-    try {
-      feed_truth_before(r.t);
-      evaluator->add_trajectory(r);
-    } catch (const InputError& e) {
-      eval_error = e.what();
-    }
-  };
 
   std::cout << "wheelins run: " << cfg.configuration << " [";
   for (std::size_t i = 0; i < req.modules.size(); ++i) std::cout << (i ? ", " : "") << req.modules[i];
@@ -169,17 +139,13 @@ int run(const RunArgs& a) {
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
 
   if (evaluate) {
-    if (eval_error.empty()) {
-      try {
-        evaluator->end_trajectory();
-        feed_truth_before(std::numeric_limits<double>::infinity());
-      } catch (const InputError& e) {
-        eval_error = e.what();
-      }
+    eval::EvalResult e;
+    try {
+      e = evaluation->finish();
+    } catch (const InputError& err) {
+      throw InputError(std::string(err.what()) + " (the trajectory was written)");
     }
-    if (!eval_error.empty()) throw InputError(eval_error + " (the trajectory was written)");
-    const eval::EvalResult e = evaluator->finish();
-    std::printf("\nagainst the truth (%s):\n", truth->file().string().c_str());
+    std::printf("\nagainst the truth (%s):\n", evaluation->truth().file().string().c_str());
     std::printf("  evaluated           %10.1f s of the %.1f s navigated (%zu truth epochs)\n",
                 e.duration, nav_s, e.epochs);
     std::printf("  distance            %10.1f m\n", e.distance);
@@ -201,7 +167,7 @@ int run(const RunArgs& a) {
                    "(%.3f .. %.3f): the truth is shorter than the data, has a gap or a clock jump "
                    "(%zu truth epochs outside the trajectory, %zu in its gaps); the figures are for "
                    "that part only\n",
-                   truth->file().string().c_str(), e.duration, e.t_start, e.t_end, nav_s, st.t_start,
+                   evaluation->truth().file().string().c_str(), e.duration, e.t_start, e.t_end, nav_s, st.t_start,
                    st.t_end, e.skipped_outside, e.skipped_gap);
   }
   return 0;

@@ -97,16 +97,22 @@ bool ImuFileReader::next(ImuSample& out) {
     }
   }
   prev_t_ = row_.t;
-  out.t = row_.t + options_.time_offset;
-  out.dt = dt;
-  if (options_.format == SampleFormat::kRate) {
-    out.dtheta = row_.gyro * dt;
-    out.dvel = row_.accel * dt;
-  } else {
-    out.dtheta = row_.gyro;
-    out.dvel = row_.accel;
-  }
+  out = imu_sample(row_, dt, options_);
   return true;
+}
+
+ImuSample imu_sample(const ImuRow& row, double dt, const ImuReadOptions& options) {
+  ImuSample out;
+  out.t = row.t + options.time_offset;
+  out.dt = dt;
+  if (options.format == SampleFormat::kRate) {
+    out.dtheta = row.gyro * dt;
+    out.dvel = row.accel * dt;
+  } else {
+    out.dtheta = row.gyro;
+    out.dvel = row.accel;
+  }
+  return out;
 }
 
 // ------------------------------------------------------------------------------- writer

@@ -49,6 +49,12 @@ struct ImuReadOptions {
 /// The read options a manifest gives a module (rate, format, layout, time offset).
 ImuReadOptions imu_read_options(const ModuleSpec& spec, const WarningSink& warn = {});
 
+/// The sample a record gives, as ImuFileReader yields it: t + time_offset, the interval dt
+/// (t - the previous record's t; 1 / rate_hz for the first), and the increments (rates
+/// times dt, or the stored increments). Streams of records that do not come from a file
+/// (the Python module's navigator) use it so they navigate exactly like the file.
+ImuSample imu_sample(const ImuRow& row, double dt, const ImuReadOptions& options);
+
 /// A time gap in a data file: the interval before record `record` (0-based).
 struct DataGap {
   std::uint64_t record = 0;

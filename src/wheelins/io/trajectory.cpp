@@ -485,6 +485,16 @@ std::string lower_ext(const std::filesystem::path& file) {
 
 }  // namespace
 
+std::vector<std::string> trajectory_csv_header() {
+  std::vector<std::string> names;
+  for (const auto& c : csv_columns()) names.emplace_back(c.name);
+  return names;
+}
+
+void trajectory_csv_values(const TrajectoryRecord& r, double* out) {
+  for (const auto& c : csv_columns()) *out++ = c.get(r);
+}
+
 TrajectoryFormat trajectory_format_from_name(const std::string& name) {
   if (name == "auto") return TrajectoryFormat::kAuto;
   if (name == "csv") return TrajectoryFormat::kCsv;

@@ -76,6 +76,13 @@ std::unique_ptr<TrajectoryWriter> make_trajectory_writer(
     TrajectoryFormat format, const std::filesystem::path& file,
     const TrajectoryWriterOptions& options = {});
 
+/// The CSV layout's column names in file order (its header row).
+std::vector<std::string> trajectory_csv_header();
+/// A record's values in the CSV's units (degrees, deg/h, ppm), in header order, at full
+/// precision (the file rounds the std and IMU-error columns to 9 digits); `out` has room
+/// for trajectory_csv_header().size() values.
+void trajectory_csv_values(const TrajectoryRecord& r, double* out);
+
 /// A trajectory read from a file, with what the format actually provided.
 struct TrajectoryData {
   std::filesystem::path file;

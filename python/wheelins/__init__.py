@@ -1,0 +1,173 @@
+"""wheelins: dead reckoning for wheeled vehicles from wheel-mounted and body IMUs.
+
+The Python face of the C++ library (the native part is wheelins._core, pybind11):
+
+    import wheelins
+    info = wheelins.simulate("out/sim", duration_s=120, chips=1)
+    result = wheelins.run(info["manifest"], configuration="triple")
+    result.trajectory["north_m"], result.metrics["drift_rate"]
+    wheelins.evaluate(truth_file, result)            # or a trajectory file
+
+    nav = wheelins.Navigator(info["manifest"], configuration="body-wheel")
+    nav.push("left-C1", t, gyro, accel)              # sample by sample, rad/s and m/s^2
+    nav.state["heading_deg"], nav.covariance("left-C1")
+
+Every error the command line reports as "error: MESSAGE" is raised as
+wheelins.InputError (a ValueError) with the same MESSAGE. See docs/python.md.
+"""
+
+import json as _json
+
+import numpy as _np
+
+from . import _core
+from ._core import InputError
+
+__all__ = ["InputError", "Navigator", "Result", "csv_columns", "evaluate", "run", "simulate"]
+
+
+def csv_columns():
+    """The trajectory CSV's column names, in file order (t_s, north_m, ..., sa_z_std_ppm)."""
+    return list(_core.csv_columns())
+
+
+def _columns(table):
+    return {name: _np.ascontiguousarray(table[:, k]) for k, name in enumerate(_core.csv_columns())}
+
+
+def _flatten(prefix, value, out):
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _flatten(f"{prefix}.{k}" if prefix else str(k), v, out)
+    else:
+        out.append(f"{prefix}={_yaml_value(value)}")
+
+
+def _yaml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if v is None:
+        return "null"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_yaml_value(x) for x in v) + "]"
+    if isinstance(v, float):
+        return repr(v)
+    return str(v)
+
+
+def simulate(out, *, force=False, progress=False, write_ideal=True, **settings):
+    """Simulates a dataset into directory `out` (what `wheelins simulate` writes).
+
+    `settings` are the keys of the dataset's scenario.yaml (docs/simulator.md), as
+    `wheelins simulate --set KEY=VALUE` takes them: seed=3, duration_s=60, chips=1,
+    static_s=10, profile="datasheet", effects=["arw", "vrw"], vehicle={"track_m": 0.4}
+    (nested dicts give dotted keys). Returns a summary dict with the manifest's path.
+    """
+    flat = []
+    for key, value in settings.items():
+        _flatten(key, value, flat)
+    return _core.simulate(out, flat, force=force, progress=progress, write_ideal=write_ideal)
+
+
+class Result:
+    """A run: .trajectory (dict of numpy arrays keyed by the trajectory CSV's header names,
+    in its units), .metrics (the evaluation against the manifest's truth, keyed as
+    `wheelins evaluate --json`; None without a truth file), .stats, .fault_report,
+    .modules, .files (written when run(out=...))."""
+
+    def __init__(self, output):
+        self._output = output
+        self.trajectory = _columns(output.table)
+        self.metrics = None if output.metrics_json is None else _json.loads(output.metrics_json)
+        self.stats = output.stats
+        self.fault_report = output.fault_report
+        self.modules = list(output.modules)
+        self.files = list(output.files)
+
+    def __repr__(self):
+        n = len(self.trajectory["t_s"])
+        return f"<wheelins.Result {'+'.join(self.modules)}: {n} records>"
+
+
+def run(manifest, configuration=None, chips=None, *, modules=None, config=None, out=None, formats=None,
+        evaluate=True, progress=False, force=False, **filter_settings):
+    """Navigates a dataset as `wheelins run` does and returns a Result.
+
+    configuration: single | dual-wheel | body-wheel | triple; chips: e.g. ["C1", "C4"]
+    (or "C1,C4"); modules: explicit module names; config: a run configuration YAML
+    (docs/run-config.md), which the other arguments override; out: a directory to write
+    the trajectory files to (default: none written). filter_settings are the options of
+    `wheelins run` by name: speed="own", centralized=True, position_constraint=False,
+    fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0.
+    """
+    if isinstance(chips, str):
+        chips = [c for c in chips.split(",") if c]
+    return Result(_core.run(manifest, configuration=configuration or "", chips=list(chips or []),
+                            modules=list(modules or []), config=config, out=out, formats=list(formats or []),
+                            evaluate=evaluate, progress=progress, force=force, **filter_settings))
+
+
+def evaluate(truth, trajectory, **options):
+    """The metrics of a trajectory against a truth file, keyed as `wheelins evaluate --json`.
+
+    trajectory: a file (wheelins CSV, TUM, Wheel-INS traj.txt) or a Result. options as
+    `wheelins evaluate`: format, truth_layout, segment, max_gap, align, origin=[lat, lon, h].
+    """
+    if isinstance(trajectory, Result):
+        trajectory = trajectory._output
+    return _json.loads(_core.evaluate(truth, trajectory, **options))
+
+
+class Navigator:
+    """A run fed sample by sample: Navigator(manifest, configuration=..., chips=...,
+    modules=..., **filter_settings) (the options of run()), then push(module, t, gyro,
+    accel) for every IMU record in time order across the modules (module: a name or its
+    index in .modules; t [s] as in the data file; gyro [rad/s], accel [m/s^2]; or the
+    increments when the manifest says format: increment). The same samples through the
+    same code as `wheelins run` give the same trajectory to the last digit.
+
+    .state: the vehicle solution now (dict keyed like the trajectory CSV; None before
+    navigation starts); .covariance(module): that subsystem's 21x21 error-state
+    covariance; .trajectory: the output records so far (dict of numpy arrays).
+    """
+
+    def __init__(self, manifest, configuration=None, chips=None, *, modules=None, config=None, **filter_settings):
+        if isinstance(chips, str):
+            chips = [c for c in chips.split(",") if c]
+        self._nav = _core.Navigator(manifest, configuration=configuration or "", chips=list(chips or []),
+                                    modules=list(modules or []), config=config, **filter_settings)
+
+    def push(self, module, t, gyro, accel):
+        """One IMU record; False once the duration limit is reached (later samples are ignored)."""
+        return self._nav.push(module, float(t), gyro, accel)
+
+    def finish(self):
+        """Ends the data (closes the fault statistics); an InputError if navigation never started."""
+        self._nav.finish()
+
+    def covariance(self, module=0):
+        return self._nav.covariance(module)
+
+    @property
+    def state(self):
+        return self._nav.state
+
+    @property
+    def modules(self):
+        return list(self._nav.modules)
+
+    @property
+    def navigating(self):
+        return self._nav.navigating
+
+    @property
+    def trajectory(self):
+        return _columns(self._nav.table)
+
+    @property
+    def stats(self):
+        return self._nav.stats
+
+    @property
+    def fault_report(self):
+        return self._nav.fault_report

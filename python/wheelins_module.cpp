@@ -1,0 +1,405 @@
+// The Python module's native part, wheelins._core (pybind11): the simulator, a run
+// (the same request `wheelins run` makes, evaluated the same way), the evaluation of a
+// trajectory (`wheelins evaluate`), and a navigator fed sample by sample through the
+// code path of a run (io/imu_file.hpp imu_sample(), fusion/navigator.hpp). InputError
+// becomes wheelins.InputError (a ValueError) with the CLI's message. The Python layer
+// on top is python/wheelins/__init__.py.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "wheelins/eval/metrics.hpp"
+#include "wheelins/eval/run_evaluation.hpp"
+#include "wheelins/io/imu_file.hpp"
+#include "wheelins/io/text_util.hpp"
+#include "wheelins/io/truth.hpp"
+#include "wheelins/run/presets.hpp"
+#include "wheelins/run/run.hpp"
+#include "wheelins/run/run_config.hpp"
+#include "wheelins/sim/simulator.hpp"
+
+namespace py = pybind11;
+using namespace wheelins;
+
+namespace {
+
+/// The records as a (n, columns) array in the trajectory CSV's units and header order.
+py::array_t<double> table(const std::vector<TrajectoryRecord>& recs) {
+  const std::size_t nc = trajectory_csv_header().size();
+  py::array_t<double> a({recs.size(), nc});
+  double* p = a.mutable_data();
+  for (const auto& r : recs) {
+    trajectory_csv_values(r, p);
+    p += nc;
+  }
+  return a;
+}
+
+py::dict stats_dict(const NavigatorStats& s) {
+  py::dict d;
+  d["samples"] = s.samples;
+  d["epochs"] = s.epochs;
+  d["velocity_updates"] = s.velocity_updates;
+  d["velocity_rejected"] = s.velocity_rejected;
+  d["position_updates"] = s.position_updates;
+  d["position_rejected"] = s.position_rejected;
+  d["records"] = s.records;
+  d["t_start"] = s.t_start;
+  d["t_end"] = s.t_end;
+  d["max_velocity_test_ratio"] = s.max_velocity_test_ratio;
+  d["max_position_test_ratio"] = s.max_position_test_ratio;
+  d["covariance_checks"] = s.covariance_checks;
+  d["covariance_not_pd"] = s.covariance_not_pd;
+  d["max_covariance_asymmetry"] = s.max_covariance_asymmetry;
+  return d;
+}
+
+/// What `wheelins run` takes besides the files, with its option names.
+struct Settings {
+  std::string configuration, config, speed;
+  std::vector<std::string> chips, modules, formats;
+  std::optional<bool> centralized, position_constraint, fault_handling;
+  double duration = 0.0, output_interval = -1.0, covariance_interval = -1.0;
+};
+
+/// The run configuration as `wheelins run` builds it from a config file and its flags.
+RunConfig run_config(const std::string& manifest, const Settings& s) {
+  RunConfig cfg = s.config.empty() ? RunConfig{} : load_run_config(s.config, stderr_sink());
+  if (!manifest.empty()) cfg.manifest = manifest;
+  if (cfg.manifest.empty())
+    throw InputError("no dataset: give a manifest (or a run configuration naming one)");
+  if (!s.configuration.empty()) cfg.configuration = s.configuration;
+  if (!s.chips.empty()) cfg.chips = s.chips;
+  if (!s.modules.empty()) cfg.modules = s.modules;
+  if (!s.formats.empty()) {
+    cfg.formats.clear();
+    for (const auto& f : s.formats) cfg.formats.push_back(trajectory_format_from_name(f));
+  }
+  if (!s.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(s.speed);
+  if (s.centralized) cfg.nav.fusion.centralized = *s.centralized;
+  if (s.position_constraint) cfg.nav.fusion.position_constraint = *s.position_constraint;
+  if (s.fault_handling) cfg.nav.faults.enabled = *s.fault_handling;
+  if (s.duration > 0) cfg.max_duration = s.duration;
+  if (s.output_interval >= 0) cfg.nav.output_interval = s.output_interval;
+  if (s.covariance_interval >= 0) {
+    if (s.covariance_interval > 0.5)
+      throw InputError("covariance_interval " + io_detail::format_double(s.covariance_interval) +
+                       ": must be in [0, 0.5] s");
+    cfg.nav.covariance_interval = s.covariance_interval;
+  }
+  return cfg;
+}
+
+std::optional<std::string> text(const py::object& o) {
+  if (o.is_none()) return std::nullopt;
+  return py::str(py::module_::import("os").attr("fspath")(o)).cast<std::string>();
+}
+
+// ----------------------------------------------------------------------------- run
+
+struct RunOutput {
+  std::vector<std::string> modules;
+  std::vector<TrajectoryRecord> records;
+  std::optional<std::string> metrics_json;
+  NavigatorStats stats;
+  std::string fault_report;
+  std::vector<std::string> files;
+  std::string manifest;
+  double wall_seconds = 0.0;
+};
+
+RunOutput run(const py::object& manifest, const std::string& configuration, const std::vector<std::string>& chips,
+              const std::vector<std::string>& modules, const py::object& config, const py::object& out,
+              const std::vector<std::string>& formats, const std::string& speed, std::optional<bool> centralized,
+              std::optional<bool> position_constraint, std::optional<bool> fault_handling, bool evaluate,
+              double duration, double output_interval, double covariance_interval, bool force, bool progress) {
+  Settings s{configuration, text(config).value_or(""), speed, chips, modules, formats,
+             centralized, position_constraint, fault_handling, duration, output_interval, covariance_interval};
+  RunConfig cfg = run_config(text(manifest).value_or(""), s);
+  if (force) cfg.overwrite = true;
+  const std::optional<std::string> out_dir = text(out);
+  RunRequest req = make_run_request(cfg, stderr_sink());
+  req.output_dir = out_dir ? std::filesystem::path(*out_dir) : std::filesystem::path();  // none: nothing written
+  req.progress = progress;
+  RunOutput o;
+  o.modules = req.modules;
+  o.manifest = req.manifest.path.string();
+  std::unique_ptr<eval::RunEvaluation> evaluation;
+  if (evaluate && req.manifest.truth_file)
+    evaluation = std::make_unique<eval::RunEvaluation>(req.manifest.resolve(*req.manifest.truth_file),
+                                                       req.manifest.origin);
+  req.on_record = [&](const TrajectoryRecord& r) {
+    o.records.push_back(r);
+    if (evaluation) evaluation->add(r);
+  };
+  RunResult res;
+  {
+    py::gil_scoped_release free;
+    res = run_navigation(req);
+  }
+  if (evaluation) {
+    try {
+      o.metrics_json = eval::to_json(evaluation->finish());
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + (req.output_dir.empty() ? "" : " (the trajectory was written)"));
+    }
+  }
+  o.stats = res.stats;
+  o.fault_report = res.fault_report;
+  for (const auto& f : res.files) o.files.push_back(f.string());
+  o.wall_seconds = res.wall_seconds;
+  return o;
+}
+
+// ------------------------------------------------------------------------ evaluate
+
+std::string evaluate(const py::object& truth_file, const py::object& trajectory, const std::string& format,
+                     const std::string& truth_layout, double segment, double max_gap, bool align,
+                     std::optional<std::vector<double>> origin) {
+  const TruthData truth = read_truth(*text(truth_file), truth_layout_from_name(truth_layout));
+  TrajectoryData traj;
+  if (py::isinstance<RunOutput>(trajectory)) {
+    const RunOutput& r = trajectory.cast<const RunOutput&>();
+    traj.file = "the run's vehicle solution";
+    traj.format = TrajectoryFormat::kCsv;
+    traj.has_lla = traj.has_ned = traj.has_velocity = traj.has_roll_pitch = traj.has_heading = traj.has_pos_std = true;
+    traj.records = r.records;
+  } else {
+    const TrajectoryFormat f = trajectory_format_from_name(format);
+    if (f == TrajectoryFormat::kKml)
+      throw InputError("format kml: KML is written for viewing only and cannot be evaluated");
+    traj = read_trajectory(*text(trajectory), f);
+  }
+  if (traj.records.empty()) throw InputError("'" + traj.file.string() + "': no trajectory records");
+  earth::Geodetic o = truth.records.front().lla;
+  if (origin) {
+    if (origin->size() != 3 || !(std::abs((*origin)[0]) <= 90.0) || !(std::abs((*origin)[1]) <= 180.0))
+      throw InputError("origin: expected [lat_deg, lon_deg, h_m] within range");
+    o = {(*origin)[0] * kDeg, (*origin)[1] * kDeg, (*origin)[2]};
+  }
+  eval::EvalOptions opt;
+  opt.segment_length = segment;
+  opt.max_gap = max_gap;
+  opt.align = align;
+  return eval::to_json(eval::evaluate(truth, traj, earth::LocalFrame(o), opt));
+}
+
+// ----------------------------------------------------------------------- simulate
+
+py::dict simulate(const py::object& out, const std::vector<std::string>& settings, bool force, bool progress,
+                  bool write_ideal) {
+  sim::SimConfig cfg;
+  for (const auto& s : settings) cfg.apply_setting(s);
+  if (!write_ideal) cfg.write_ideal = false;
+  const std::string dir = *text(out);
+  sim::DatasetSummary sum;
+  {
+    const sim::Simulation simulation(cfg);
+    py::gil_scoped_release free;
+    sum = simulation.write(dir, force, progress);
+  }
+  py::dict d;
+  d["manifest"] = (std::filesystem::path(dir) / "manifest.yaml").string();
+  d["scenario"] = sum.scenario;
+  d["duration_s"] = sum.duration;
+  d["distance_m"] = sum.distance;
+  d["imu_rows"] = sum.imu_rows;
+  d["files"] = sum.files;
+  d["bytes"] = sum.bytes;
+  d["seconds"] = sum.seconds;
+  return d;
+}
+
+// ---------------------------------------------------------------------- navigator
+
+/// A run fed sample by sample: the request `wheelins run` makes (without files), the
+/// samples made from the pushed records by io/imu_file.hpp imu_sample() as the file
+/// reader makes them, the duration limit applied as run_navigation() applies it.
+class StreamNavigator {
+ public:
+  StreamNavigator(const py::object& manifest, const std::string& configuration, const std::vector<std::string>& chips,
+                  const std::vector<std::string>& modules, const py::object& config, const std::string& speed,
+                  std::optional<bool> centralized, std::optional<bool> position_constraint,
+                  std::optional<bool> fault_handling, double duration, double output_interval,
+                  double covariance_interval) {
+    Settings s{configuration, text(config).value_or(""), speed, chips, modules, {},
+               centralized, position_constraint, fault_handling, duration, output_interval, covariance_interval};
+    req_ = make_run_request(run_config(text(manifest).value_or(""), s), stderr_sink());
+    for (const auto& name : req_.modules) {
+      const ModuleSpec* spec = req_.manifest.find(name);
+      if (!spec) throw InputError("'" + req_.manifest.path.string() + "': no module named '" + name + "'");
+      Track t;
+      t.options = imu_read_options(*spec);
+      tracks_.push_back(t);
+    }
+    NavigatorOptions nav = req_.nav;
+    nav.module_records = false;  // as a run that writes no subsystem files
+    nav_ = std::make_unique<Navigator>(req_.manifest, req_.modules, nav, [this](int stream, const TrajectoryRecord& r) {
+      if (stream == 0) records_.push_back(r);
+    });
+  }
+
+  int index_of(const py::object& module) const {
+    if (py::isinstance<py::int_>(module)) {
+      const int i = module.cast<int>();
+      if (i < 0 || i >= static_cast<int>(req_.modules.size()))
+        throw InputError("module index " + std::to_string(i) + " out of range (0.." +
+                         std::to_string(req_.modules.size() - 1) + ")");
+      return i;
+    }
+    const std::string name = module.cast<std::string>();
+    for (std::size_t i = 0; i < req_.modules.size(); ++i)
+      if (req_.modules[i] == name) return static_cast<int>(i);
+    std::string list;
+    for (const auto& m : req_.modules) list += (list.empty() ? "" : ", ") + m;
+    throw InputError("module '" + name + "' is not navigated (modules: " + list + ")");
+  }
+
+  /// One record of module `module` as its file holds it; false once the duration is reached.
+  bool push(const py::object& module, double t, const std::array<double, 3>& gyro, const std::array<double, 3>& accel) {
+    if (finished_) throw InputError("push after finish()");
+    if (stopped_) return false;
+    const int i = index_of(module);
+    Track& tr = tracks_[static_cast<std::size_t>(i)];
+    const std::string where = "module '" + req_.modules[static_cast<std::size_t>(i)] + "', sample " + std::to_string(tr.count);
+    const double v[7] = {t, gyro[0], gyro[1], gyro[2], accel[0], accel[1], accel[2]};
+    for (int c = 0; c < 7; ++c)
+      if (!std::isfinite(v[c]))
+        throw InputError(where + " (0-based), column " + std::to_string(c) + " (" + kImuColumnNames[c] +
+                         "): value is " + (std::isnan(v[c]) ? "NaN" : "infinite"));
+    double dt;
+    if (tr.count == 0) {
+      dt = 1.0 / tr.options.rate_hz;
+    } else {
+      dt = t - tr.prev_t;
+      if (!(dt > 0.0))
+        throw InputError(where + " (0-based): time " + io_detail::format_double(t) +
+                         (dt == 0.0 ? " repeats the previous sample's time" : " goes back from the previous sample's " + io_detail::format_double(tr.prev_t)) +
+                         " (timestamps must be strictly increasing)");
+    }
+    ImuRow row;
+    row.t = t;
+    row.gyro = Vec3(gyro[0], gyro[1], gyro[2]);
+    row.accel = Vec3(accel[0], accel[1], accel[2]);
+    const ImuSample s = imu_sample(row, dt, tr.options);
+    if (s.t < last_t_)
+      throw InputError(where + " (0-based): time " + io_detail::format_double(s.t) + " is before the last sample pushed (" +
+                       io_detail::format_double(last_t_) + "): push the modules' samples in time order");
+    tr.prev_t = t;
+    ++tr.count;
+    last_t_ = s.t;
+    nav_->process(i, s);
+    if (req_.max_duration > 0 && nav_->navigating() && s.t - nav_->stats().t_start >= req_.max_duration) stopped_ = true;
+    return !stopped_;
+  }
+
+  void finish() {
+    if (finished_) return;
+    if (!nav_->navigating()) {
+      char period[96];
+      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", req_.manifest.static_start, req_.manifest.static_end);
+      throw InputError("the samples end before the static period " + std::string(period) + " of '" +
+                       req_.manifest.path.string() + "' does: nothing to navigate");
+    }
+    nav_->finish();
+    finished_ = true;
+  }
+
+  py::object state() const {
+    if (!nav_->navigating()) return py::none();
+    const TrajectoryRecord r = nav_->vehicle_record();
+    const auto names = trajectory_csv_header();
+    std::vector<double> v(names.size());
+    trajectory_csv_values(r, v.data());
+    py::dict d;
+    for (std::size_t k = 0; k < names.size(); ++k) d[py::str(names[k])] = v[k];
+    return d;
+  }
+
+  py::array_t<double> covariance(const py::object& module) const {
+    const int i = index_of(module);
+    if (!nav_->navigating()) throw InputError("no covariance before navigation starts (the static period)");
+    if (req_.nav.fusion.centralized)
+      throw InputError("the centralized filter keeps one joint covariance; its per-module blocks are not "
+                       "exposed (the state's *_std_* entries are the vehicle's sigmas)");
+    const Mat21& P = nav_->subsystem(i).ekf().covariance();
+    py::array_t<double> a({21, 21});
+    for (int r = 0; r < 21; ++r)
+      for (int c = 0; c < 21; ++c) a.mutable_at(r, c) = P(r, c);
+    return a;
+  }
+
+  const std::vector<std::string>& modules() const { return req_.modules; }
+  bool navigating() const { return nav_->navigating(); }
+  py::array_t<double> records() const { return table(records_); }
+  std::size_t record_count() const { return records_.size(); }
+  py::dict stats() const { return stats_dict(nav_->stats()); }
+  std::string fault_report() const { return fault_report_text(nav_->faults()); }
+
+ private:
+  struct Track {
+    ImuReadOptions options;
+    double prev_t = 0.0;
+    std::uint64_t count = 0;
+  };
+  RunRequest req_;
+  std::vector<Track> tracks_;
+  std::unique_ptr<Navigator> nav_;
+  std::vector<TrajectoryRecord> records_;
+  double last_t_ = -std::numeric_limits<double>::infinity();
+  bool stopped_ = false, finished_ = false;
+};
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "wheelins native core (use the wheelins package)";
+  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  m.def("csv_columns", &trajectory_csv_header, "The trajectory CSV's column names, in order");
+
+  py::class_<RunOutput>(m, "RunOutput")
+      .def_readonly("modules", &RunOutput::modules)
+      .def_readonly("metrics_json", &RunOutput::metrics_json)
+      .def_readonly("fault_report", &RunOutput::fault_report)
+      .def_readonly("files", &RunOutput::files)
+      .def_readonly("manifest", &RunOutput::manifest)
+      .def_readonly("wall_seconds", &RunOutput::wall_seconds)
+      .def_property_readonly("stats", [](const RunOutput& r) { return stats_dict(r.stats); })
+      .def_property_readonly("table", [](const RunOutput& r) { return table(r.records); });
+
+  m.def("run", &run, py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
+        py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("out") = py::none(),
+        py::arg("formats") = std::vector<std::string>{}, py::arg("speed") = "", py::arg("centralized") = py::none(),
+        py::arg("position_constraint") = py::none(), py::arg("fault_handling") = py::none(), py::arg("evaluate") = true,
+        py::arg("duration") = 0.0, py::arg("output_interval") = -1.0, py::arg("covariance_interval") = -1.0,
+        py::arg("force") = false, py::arg("progress") = false);
+  m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
+        py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
+        py::arg("origin") = py::none());
+  m.def("simulate", &simulate, py::arg("out"), py::arg("settings"), py::arg("force") = false, py::arg("progress") = false,
+        py::arg("write_ideal") = true);
+
+  py::class_<StreamNavigator>(m, "Navigator")
+      .def(py::init<const py::object&, const std::string&, const std::vector<std::string>&, const std::vector<std::string>&,
+                    const py::object&, const std::string&, std::optional<bool>, std::optional<bool>, std::optional<bool>,
+                    double, double, double>(),
+           py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
+           py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("speed") = "",
+           py::arg("centralized") = py::none(), py::arg("position_constraint") = py::none(),
+           py::arg("fault_handling") = py::none(), py::arg("duration") = 0.0, py::arg("output_interval") = -1.0,
+           py::arg("covariance_interval") = -1.0)
+      .def("push", &StreamNavigator::push, py::arg("module"), py::arg("t"), py::arg("gyro"), py::arg("accel"))
+      .def("finish", &StreamNavigator::finish)
+      .def("covariance", &StreamNavigator::covariance, py::arg("module") = 0)
+      .def_property_readonly("state", &StreamNavigator::state)
+      .def_property_readonly("modules", &StreamNavigator::modules)
+      .def_property_readonly("navigating", &StreamNavigator::navigating)
+      .def_property_readonly("table", &StreamNavigator::records)
+      .def_property_readonly("record_count", &StreamNavigator::record_count)
+      .def_property_readonly("stats", &StreamNavigator::stats)
+      .def_property_readonly("fault_report", &StreamNavigator::fault_report);
+}

@@ -1,0 +1,43 @@
+// The evaluation `wheelins run` makes as it runs (and the Python module's run()):
+// the truth file is streamed in step with the vehicle solution, taken every
+// kInterval seconds, so memory stays flat however long the data. A truth file that
+// cannot be opened, or whose first record is bad, throws from the constructor
+// (before the run); a bad record met later is held and thrown by finish(), so the
+// caller can write the trajectory first.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "wheelins/eval/metrics.hpp"
+#include "wheelins/io/truth.hpp"
+
+namespace wheelins::eval {
+
+class RunEvaluation {
+ public:
+  static constexpr double kInterval = 0.05;  ///< [s] between the records evaluated (20 Hz)
+
+  RunEvaluation(const std::filesystem::path& truth_file, const earth::Geodetic& origin);
+  ~RunEvaluation();
+  RunEvaluation(const RunEvaluation&) = delete;
+  RunEvaluation& operator=(const RunEvaluation&) = delete;
+
+  /// Every vehicle record of the run, in time order (RunRequest::on_record).
+  void add(const TrajectoryRecord& r);
+  /// The metrics after the run; InputError for a bad truth record met on the way.
+  EvalResult finish();
+  const TruthReader& truth() const { return *truth_; }
+
+ private:
+  void feed_truth_before(double t);
+  std::unique_ptr<TruthReader> truth_;
+  std::unique_ptr<Evaluator> evaluator_;
+  TruthRecord next_truth_;
+  bool have_next_truth_ = false;
+  double next_keep_ = -1e300;
+  std::string error_;
+};
+
+}  // namespace wheelins::eval
