@@ -109,6 +109,7 @@ struct RunOutput {
   std::string fault_report;
   std::vector<std::string> files;
   std::string manifest;
+  std::vector<double> origin_deg;  ///< the manifest's origin: lat [deg], lon [deg], h [m]
   double wall_seconds = 0.0;
 };
 
@@ -128,6 +129,7 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
   RunOutput o;
   o.modules = req.modules;
   o.manifest = req.manifest.path.string();
+  o.origin_deg = {req.manifest.origin.lat / kDeg, req.manifest.origin.lon / kDeg, req.manifest.origin.h};
   std::unique_ptr<eval::RunEvaluation> evaluation;
   if (evaluate && req.manifest.truth_file)
     evaluation = std::make_unique<eval::RunEvaluation>(req.manifest.resolve(*req.manifest.truth_file),
@@ -157,9 +159,12 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
 
 // ------------------------------------------------------------------------ evaluate
 
-std::string evaluate(const py::object& truth_file, const py::object& trajectory, const std::string& format,
-                     const std::string& truth_layout, double segment, double max_gap, bool align,
-                     std::optional<std::vector<double>> origin) {
+/// The metrics as `wheelins evaluate --json` writes them and, with `series`, the per-epoch
+/// errors as `wheelins evaluate --series` writes them (columns t_s, distance_m, err_n_m,
+/// err_e_m, err_d_m, err_h_m, heading_err_deg, sigma_h_m, nees_h).
+py::tuple evaluate(const py::object& truth_file, const py::object& trajectory, const std::string& format,
+                   const std::string& truth_layout, double segment, double max_gap, bool align,
+                   std::optional<std::vector<double>> origin, bool series) {
   const TruthData truth = read_truth(*text(truth_file), truth_layout_from_name(truth_layout));
   TrajectoryData traj;
   if (py::isinstance<RunOutput>(trajectory)) {
@@ -185,7 +190,38 @@ std::string evaluate(const py::object& truth_file, const py::object& trajectory,
   opt.segment_length = segment;
   opt.max_gap = max_gap;
   opt.align = align;
-  return eval::to_json(eval::evaluate(truth, traj, earth::LocalFrame(o), opt));
+  const eval::EvalResult res = eval::evaluate(truth, traj, earth::LocalFrame(o), opt);
+  if (!series) return py::make_tuple(eval::to_json(res), py::none());
+  py::array_t<double> a({res.series.size(), std::size_t(9)});
+  for (std::size_t k = 0; k < res.series.size(); ++k) {
+    const eval::EpochError& e = res.series[k];
+    const double v[9] = {e.t, e.distance, e.err_ned.x(), e.err_ned.y(), e.err_ned.z(), e.err_h,
+                         e.heading_err / kDeg, e.sigma_h, e.nees_h};
+    for (int c = 0; c < 9; ++c) a.mutable_at(k, c) = v[c];
+  }
+  return py::make_tuple(eval::to_json(res), a);
+}
+
+/// A truth file in the local frame about `origin` (default: its first record): columns
+/// t_s, north_m, east_m, down_m, lat_deg, lon_deg, h_m, vn_m_s, ve_m_s, vd_m_s, roll_deg,
+/// pitch_deg, heading_deg.
+py::array_t<double> read_truth_table(const py::object& file, std::optional<std::vector<double>> origin) {
+  const TruthData truth = read_truth(*text(file));
+  earth::Geodetic o = truth.records.front().lla;
+  if (origin) {
+    if (origin->size() != 3) throw InputError("origin: expected [lat_deg, lon_deg, h_m]");
+    o = {(*origin)[0] * kDeg, (*origin)[1] * kDeg, (*origin)[2]};
+  }
+  const earth::LocalFrame frame(o);
+  py::array_t<double> a({truth.records.size(), std::size_t(13)});
+  for (std::size_t k = 0; k < truth.records.size(); ++k) {
+    const TruthRecord& r = truth.records[k];
+    const Vec3 p = frame.ned_from_geodetic(r.lla);
+    const double v[13] = {r.t, p.x(), p.y(), p.z(), r.lla.lat / kDeg, r.lla.lon / kDeg, r.lla.h, r.v_ned.x(),
+                          r.v_ned.y(), r.v_ned.z(), r.rpy.x() / kDeg, r.rpy.y() / kDeg, r.rpy.z() / kDeg};
+    for (int c = 0; c < 13; ++c) a.mutable_at(k, c) = v[c];
+  }
+  return a;
 }
 
 // ----------------------------------------------------------------------- simulate
@@ -367,6 +403,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("fault_report", &RunOutput::fault_report)
       .def_readonly("files", &RunOutput::files)
       .def_readonly("manifest", &RunOutput::manifest)
+      .def_readonly("origin_deg", &RunOutput::origin_deg)
       .def_readonly("wall_seconds", &RunOutput::wall_seconds)
       .def_property_readonly("stats", [](const RunOutput& r) { return stats_dict(r.stats); })
       .def_property_readonly("table", [](const RunOutput& r) { return table(r.records); });
@@ -379,7 +416,8 @@ PYBIND11_MODULE(_core, m) {
         py::arg("force") = false, py::arg("progress") = false);
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
-        py::arg("origin") = py::none());
+        py::arg("origin") = py::none(), py::arg("series") = false);
+  m.def("read_truth", &read_truth_table, py::arg("truth"), py::arg("origin") = py::none());
   m.def("simulate", &simulate, py::arg("out"), py::arg("settings"), py::arg("force") = false, py::arg("progress") = false,
         py::arg("write_ideal") = true);
 

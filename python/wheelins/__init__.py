@@ -23,7 +23,7 @@ import numpy as _np
 from . import _core
 from ._core import InputError
 
-__all__ = ["InputError", "Navigator", "Result", "csv_columns", "evaluate", "run", "simulate"]
+__all__ = ["InputError", "Navigator", "Result", "csv_columns", "evaluate", "read_truth", "run", "simulate"]
 
 
 def csv_columns():
@@ -83,6 +83,7 @@ class Result:
         self.fault_report = output.fault_report
         self.modules = list(output.modules)
         self.files = list(output.files)
+        self.origin = list(output.origin_deg)  # the trajectory's north/east/down origin
 
     def __repr__(self):
         n = len(self.trajectory["t_s"])
@@ -107,15 +108,34 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
                             evaluate=evaluate, progress=progress, force=force, **filter_settings))
 
 
-def evaluate(truth, trajectory, **options):
+_SERIES = ["t_s", "distance_m", "err_n_m", "err_e_m", "err_d_m", "err_h_m", "heading_err_deg", "sigma_h_m", "nees_h"]
+_TRUTH = ["t_s", "north_m", "east_m", "down_m", "lat_deg", "lon_deg", "h_m", "vn_m_s", "ve_m_s", "vd_m_s",
+          "roll_deg", "pitch_deg", "heading_deg"]
+
+
+def evaluate(truth, trajectory, *, series=False, **options):
     """The metrics of a trajectory against a truth file, keyed as `wheelins evaluate --json`.
 
     trajectory: a file (wheelins CSV, TUM, Wheel-INS traj.txt) or a Result. options as
     `wheelins evaluate`: format, truth_layout, segment, max_gap, align, origin=[lat, lon, h].
+    series=True adds "series": the per-epoch errors as `wheelins evaluate --series` writes
+    them (dict of numpy arrays: t_s, distance_m, err_n_m, ..., nees_h).
     """
     if isinstance(trajectory, Result):
         trajectory = trajectory._output
-    return _json.loads(_core.evaluate(truth, trajectory, **options))
+    text, table = _core.evaluate(truth, trajectory, series=series, **options)
+    metrics = _json.loads(text)
+    if series:
+        metrics["series"] = {name: _np.ascontiguousarray(table[:, k]) for k, name in enumerate(_SERIES)}
+    return metrics
+
+
+def read_truth(truth, origin=None):
+    """A truth file (GINS.bin) as a dict of numpy arrays: t_s, north_m, east_m, down_m about
+    `origin` ([lat_deg, lon_deg, h_m]; default its first record; a Result's .origin is the
+    frame of its trajectory), lat_deg, lon_deg, h_m, vn/ve/vd_m_s, roll/pitch/heading_deg."""
+    table = _core.read_truth(truth, origin=None if origin is None else list(origin))
+    return {name: _np.ascontiguousarray(table[:, k]) for k, name in enumerate(_TRUTH)}
 
 
 class Navigator:

@@ -1,0 +1,186 @@
+"""The Python module against the command line: the same runs, the same figures, the
+streaming navigator to the last digit, the same error messages. Run by CTest
+(python_tests) with PYTHONPATH=build/python and WHEELINS_BINARY set."""
+
+import csv
+import json
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import wheelins
+
+WHEELINS = os.environ.get("WHEELINS_BINARY", "wheelins")
+SOURCE = os.environ.get("WHEELINS_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+# The CSV's columns written at full precision (shortest round trip); the others have 9 digits.
+FULL = ["t_s", "north_m", "east_m", "down_m", "lat_deg", "lon_deg", "h_m", "vn_m_s", "ve_m_s", "vd_m_s",
+        "roll_deg", "pitch_deg", "heading_deg"]
+
+
+def cli(*args, check=True):
+    p = subprocess.run([WHEELINS, *map(str, args)], capture_output=True, text=True)
+    if check and p.returncode != 0:
+        raise AssertionError(f"wheelins {' '.join(map(str, args))}: {p.returncode}\n{p.stderr}")
+    return p
+
+
+def read_csv(path):
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    return {name: np.array([float(r[k]) for r in rows[1:]]) for k, name in enumerate(rows[0])}
+
+
+def same_as_csv(traj, csv_cols):
+    """Every column of an in-memory trajectory equals the CSV: exactly where the CSV has
+    full precision, at its 9 significant digits elsewhere."""
+    assert list(traj) == list(csv_cols)
+    for name, values in csv_cols.items():
+        mine = traj[name]
+        assert mine.shape == values.shape, name
+        if name in FULL:
+            np.testing.assert_array_equal(mine, values, err_msg=name)
+        else:
+            np.testing.assert_array_equal(np.array([float(f"{v:.9g}") for v in mine]), values, err_msg=name)
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sim")
+    info = wheelins.simulate(out / "sim", duration_s=40, static_s=10, chips=1, seed=5, write_ideal=False)
+    assert os.path.exists(info["manifest"])
+    return info
+
+
+@pytest.fixture(scope="module")
+def cli_triple(dataset, tmp_path_factory):
+    out = tmp_path_factory.mktemp("cli")
+    p = cli("run", "-m", dataset["manifest"], "-c", "triple", "-o", out, "-q")
+    return out, p.stdout
+
+
+def test_simulate_writes_what_the_cli_writes(dataset, tmp_path):
+    cli("simulate", "--out", tmp_path / "c", "--duration", 40, "--static", 10, "--chips", 1, "--seed", 5,
+        "--no-ideal", "-q")
+    sim = os.path.dirname(dataset["manifest"])
+    for rel in ["left-wheel-imu/tri_C1_imu.bin", "body-imu/tri_C1_imu.bin", "GINS.bin", "odo.bin"]:
+        with open(os.path.join(sim, rel), "rb") as a, open(tmp_path / "c" / rel, "rb") as b:
+            assert a.read() == b.read(), rel
+
+
+def test_run_gives_the_cli_trajectory_and_figures(dataset, cli_triple):
+    out, stdout = cli_triple
+    r = wheelins.run(dataset["manifest"], configuration="triple")
+    assert r.modules == ["left-C1", "right-C1", "body-C1"]
+    same_as_csv(r.trajectory, read_csv(out / "trajectory.csv"))
+    # The figures `wheelins run` prints come from the same evaluation.
+    m = r.metrics
+    printed = {
+        "distance_m": (r"distance\s+([\d.]+) m", 1),
+        "heading_rmse_deg": (r"heading RMSE\s+([\d.]+) deg", 3),
+        "max_error_m": (r"max / final error\s+([\d.]+) /", 2),
+        "final_error_m": (r"max / final error\s+[\d.]+ / ([\d.]+) m", 2),
+        "mean_nees_h": (r"mean NEES ([\d.]+)", 2),
+    }
+    for key, (pattern, digits) in printed.items():
+        found = re.search(pattern, stdout)
+        assert found, (key, stdout)
+        assert f"{m[key]:.{digits}f}" == found.group(1), key
+    # evaluate() of the written trajectory is `wheelins evaluate --json` of it.
+    truth = os.path.join(os.path.dirname(dataset["manifest"]), "GINS.bin")
+    mine = wheelins.evaluate(truth, out / "trajectory.csv")
+    theirs = json.loads(cli("evaluate", "--truth", truth, "--traj", out / "trajectory.csv", "--json", "-").stdout)
+    assert mine == theirs
+    # ... and of the run in memory, the same figures to the CSV's rounding.
+    memory = wheelins.evaluate(truth, r)
+    for key in ["distance_m", "max_error_m", "final_error_m", "rms_error_m", "heading_rmse_deg"]:
+        assert memory[key] == pytest.approx(theirs[key], rel=1e-9, abs=1e-12), key
+    series = wheelins.evaluate(truth, r, series=True)["series"]
+    assert len(series["t_s"]) == memory["epochs"]
+
+
+def test_run_options_and_files(dataset, tmp_path):
+    r = wheelins.run(dataset["manifest"], "body-wheel", out=tmp_path / "bw", formats=["csv"], centralized=True,
+                     position_constraint=False, duration=15.0, output_interval=0.1)
+    cli("run", "-m", dataset["manifest"], "-c", "body-wheel", "-o", tmp_path / "cli", "--formats", "csv",
+        "--centralized", "--no-position-constraint", "--duration", 15, "--output-interval", 0.1, "-q")
+    same_as_csv(r.trajectory, read_csv(tmp_path / "cli" / "trajectory.csv"))
+    same_as_csv(r.trajectory, read_csv(tmp_path / "bw" / "trajectory.csv"))
+    assert str(tmp_path / "bw" / "trajectory.csv") in r.files
+    with pytest.raises(TypeError):
+        wheelins.run(dataset["manifest"], no_such_setting=1)
+
+
+def load_rows(dataset, module_file):
+    return np.fromfile(os.path.join(os.path.dirname(dataset["manifest"]), module_file), dtype="<f8").reshape(-1, 7)
+
+
+@pytest.mark.parametrize("configuration,files", [
+    ("triple", ["left-wheel-imu/tri_C1_imu.bin", "right-wheel-imu/tri_C1_imu.bin", "body-imu/tri_C1_imu.bin"]),
+])
+def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, cli_triple, configuration, files):
+    out, _ = cli_triple
+    nav = wheelins.Navigator(dataset["manifest"], configuration=configuration)
+    assert nav.modules == ["left-C1", "right-C1", "body-C1"]
+    # The simulated manifest has no time offsets: merge by the file times, ties in module order.
+    rows = [load_rows(dataset, f) for f in files]
+    order = sorted((r[k, 0], i, k) for i, r in enumerate(rows) for k in range(len(r)))
+    assert nav.state is None
+    half = len(order) // 2
+    for n, (_, i, k) in enumerate(order):
+        row = rows[i][k]
+        nav.push(i if n % 2 else nav.modules[i], row[0], row[1:4], row[4:7])
+        if n == half:
+            state = nav.state
+            assert state is not None and set(state) == set(wheelins.csv_columns())
+            P = nav.covariance("left-C1")
+            assert P.shape == (21, 21)
+            np.testing.assert_allclose(P, P.T, rtol=0, atol=1e-12 * np.abs(P).max())
+            assert np.all(np.linalg.eigvalsh(0.5 * (P + P.T)) > -1e-12 * np.abs(P).max())
+            assert state["north_std_m"] > 0
+    nav.finish()
+    same_as_csv(nav.trajectory, read_csv(out / "trajectory.csv"))
+
+
+def test_errors_are_the_cli_messages(dataset, tmp_path):
+    missing = tmp_path / "nothere.yaml"
+    p = cli("run", "-m", missing, "-q", check=False)
+    assert p.returncode == 2
+    with pytest.raises(wheelins.InputError) as e:
+        wheelins.run(missing)
+    assert p.stderr.strip() == f"error: {e.value}"
+    assert isinstance(e.value, ValueError)
+    p = cli("run", "-m", dataset["manifest"], "-c", "quadruple", "-q", check=False)
+    with pytest.raises(wheelins.InputError) as e:
+        wheelins.run(dataset["manifest"], configuration="quadruple")
+    assert p.stderr.strip().endswith(f"error: {e.value}")
+
+    nav = wheelins.Navigator(dataset["manifest"], configuration="body-wheel")
+    with pytest.raises(wheelins.InputError, match="module 'right-C1' is not navigated"):
+        nav.push("right-C1", 1.0, [0, 0, 0], [0, 0, 0])
+    nav.push(0, 100000.005, [0, 0, 0], [0, 0, -9.8])
+    with pytest.raises(wheelins.InputError, match=r"module '.*', sample 1 \(0-based\): time 100000.005 repeats"):
+        nav.push(0, 100000.005, [0, 0, 0], [0, 0, -9.8])
+    with pytest.raises(wheelins.InputError, match=r"column 5 \(accel_y\): value is NaN"):
+        nav.push(0, 100000.01, [0, 0, 0], [0, float("nan"), -9.8])
+    with pytest.raises(wheelins.InputError, match="before the last sample pushed"):
+        nav.push(1, 99999.0, [0, 0, 0], [0, 0, -9.8])
+    with pytest.raises(wheelins.InputError, match="nothing to navigate"):
+        nav.finish()
+
+
+def test_example_script_runs_headless(tmp_path):
+    script = os.path.join(SOURCE, "examples", "body_wheel_ins.py")
+    env = dict(os.environ, MPLBACKEND="Agg")
+    env.pop("DISPLAY", None)
+    p = subprocess.run([sys.executable, script, str(tmp_path), "--duration", "60"], capture_output=True, text=True,
+                       env=env)
+    assert p.returncode == 0, p.stderr
+    assert "wrote" in p.stdout
+    png = tmp_path / "body_wheel_ins.png"
+    assert png.stat().st_size > 10000
+    with open(png, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
