@@ -18,8 +18,9 @@ configure: setup
 build: configure
 	@cmake --build $(BUILD) -j$(JOBS)
 
+# The CLI and the Python module (build/python: PYTHONPATH=build/python /usr/bin/python3).
 build-cli: configure
-	@cmake --build $(BUILD) -j$(JOBS) --target wheelins
+	@cmake --build $(BUILD) -j$(JOBS) --target wheelins wheelins_python
 
 # Simulate the built-in default scenario, then run the main job on it.
 demo: build-cli

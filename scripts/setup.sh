@@ -3,6 +3,9 @@
 # Idempotent: when everything is present it only checks and returns.
 # gnuplot-nox draws the plots of `wheelins experiment` and `wheelins study report` (optional at
 # run time); parallel (GNU parallel) runs a study's jobs in scripts/study-parallel.sh.
+# ROS recordings (`wheelins import`): the ROS 1 bag library and message headers, sqlite3,
+# zstd and lz4. The Python module: pybind11 and Debian's python3 (/usr/bin/python3) with
+# numpy, pytest and matplotlib (its tests and the example in examples/).
 # Optional groups, named as arguments: `fuzz` (clang and its libFuzzer/sanitizer
 # runtime, for scripts/fuzz.sh).
 # Usage: scripts/setup.sh [fuzz]
@@ -13,6 +16,9 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox parallel
+  librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev
+  libsqlite3-dev libzstd-dev liblz4-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 )
 for group in "$@"; do
   case $group in

@@ -112,9 +112,10 @@ void McapReader::fail(std::uint64_t offset, const std::string& what) const {
 
 bool McapReader::read_bytes(std::uint8_t* out, std::size_t n) {
   if (n > size_ - pos_) return false;
+  if (n == 0) return true;  // (an empty record: out may be null)
   if (mem_) {
     std::memcpy(out, mem_ + pos_, n);
-  } else if (n && std::fread(out, 1, n, fp_) != n) {
+  } else if (std::fread(out, 1, n, fp_) != n) {
     fail(pos_, "read error");
   }
   pos_ += n;
