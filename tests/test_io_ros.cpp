@@ -4,6 +4,7 @@
 // original; bad recordings give InputErrors naming file, topic and message.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -516,4 +517,43 @@ TEST(RosCdr, DecodesAlignedFieldsInBothByteOrdersAndRejectsShortData) {
   EXPECT_EQ(ros::crc32(reinterpret_cast<const std::uint8_t*>("123456789"), 9), 0xCBF43926u);
 }
 
+}  // namespace
+
+namespace {
+// The command: a bag in, the dataset and the list of what is still to fill in out; a
+// bad one: exit 2 and the error naming file, topic and message.
+TEST(RosImportCli, ImportsOrFailsWithExitCodeAndMessage) {
+  const fs::path dir = scratch("cli");
+  fs::create_directories(dir);
+  auto m = small_bag();
+  write_ros2_mcap(dir / "ok.mcap", m);
+  m[7].imu.gyro[2] = INFINITY;
+  write_ros1_bag(dir / "bad.bag", m);
+  auto run = [&](const std::string& args, std::string& out) {
+    const std::string cmd = std::string("'") + WHEELINS_BINARY + "' import " + args + " >'" +
+                            (dir / "stdout").string() + "' 2>&1";
+    const int status = std::system(cmd.c_str());
+    std::ifstream in(dir / "stdout");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    out = ss.str();
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  std::string out;
+  EXPECT_EQ(run("'" + (dir / "ok.mcap").string() + "' --out '" + (dir / "ds").string() + "' --odometry /odom", out), 0)
+      << out;
+  EXPECT_NE(out.find("ROS 2 MCAP"), std::string::npos) << out;
+  EXPECT_NE(out.find("still to fill in"), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(dir / "ds" / "imu_imu.bin") && fs::exists(dir / "ds" / "odo.bin") &&
+              fs::exists(dir / "ds" / "manifest.yaml"));
+  EXPECT_NO_THROW(load_manifest(dir / "ds" / "manifest.yaml", {}));
+  EXPECT_EQ(run("'" + (dir / "bad.bag").string() + "' --out '" + (dir / "ds2").string() + "'", out), 2) << out;
+  EXPECT_NE(out.find("error: '" + (dir / "bad.bag").string() +
+                     "': topic '/imu', message 5 (0-based): angular_velocity.z is infinite"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(run("'" + (dir / "ok.mcap").string() + "' --out '" + (dir / "ds").string() + "'", out), 2) << out;
+  EXPECT_NE(out.find("is not empty (use --force"), std::string::npos) << out;
+  fs::remove_all(dir);
+}
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 
@@ -194,6 +196,21 @@ void Importer::apply_tf(ImportResult& res, const std::vector<Transform>& tf) con
   }
 }
 
+/// The first sample of a wheel gyro after t_from that shows the wheel rolling (0.5 rad/s),
+/// within 900 s, as the manifest draft looks for it.
+std::optional<double> first_rolling(const fs::path& file, double t_from) {
+  ImuReadOptions o;
+  o.gap_factor = std::numeric_limits<double>::infinity();
+  ImuFileReader r(file, o);
+  ImuSample s;
+  while (r.next(s)) {
+    if (s.t < t_from) continue;
+    if (s.t > t_from + 900.0) break;
+    if (r.row().gyro.norm() > 0.5) return s.t;
+  }
+  return std::nullopt;
+}
+
 /// Module kinds by name: "body", "base" or "chassis" -> a Body-IMU, else a Wheel-IMU.
 bool looks_like_body(const std::string& name) {
   std::string s;
@@ -375,6 +392,24 @@ ImportResult Importer::run() {
     }
   }
   d.todo.push_back("modules: the kind of each (wheel or body) was guessed from its name; check it");
+  // The draft looked for the first motion in the first module's gyro taking every module for
+  // a wheel; with the kinds known, a Wheel-IMU's gyro tells it.
+  if (!(man.static_end > man.static_start))
+    for (const ModuleSpec& s : man.modules)
+      if (s.kind == ModuleKind::kWheel) {
+        if (const auto t = first_rolling(man.resolve(s.file), man.static_start); t && *t - 0.5 - man.static_start >= 1.0) {
+          man.static_end = *t - 0.5;
+          d.notes.comments["static_period_s"] = "until 0.5 s before the first motion (wheel gyro of " + s.name + ")";
+          std::erase_if(d.todo, [](const std::string& x) { return x.rfind("static_period_s", 0) == 0; });
+          char buf[48];
+          std::snprintf(buf, sizeof buf, "static period %.2f s", man.static_end - man.static_start);
+          res.facts.push_back(buf + (" (wheel gyro of " + s.name + ")"));
+        }
+        break;
+      }
+  std::erase_if(d.facts, [](const std::string& x) { return x.find(" layout: ") != std::string::npos; });
+  d.facts.insert(d.facts.begin(), std::to_string(res.imu.size()) + " IMU module(s) from " +
+                                      std::to_string(res.imu.size()) + " sensor_msgs/Imu topic(s)");
   if (!transforms.empty()) apply_tf(res, transforms);
   d.notes.header = {"drafted by `wheelins import` from " + fs::absolute(rec_).lexically_normal().string() +
                         " (" + res.format + ")",
@@ -382,8 +417,9 @@ ImportResult Importer::run() {
   save_manifest(man, manifest_file, d.notes);
   res.manifest_file = manifest_file;
   res.facts.insert(res.facts.begin(), d.facts.begin(), d.facts.end());
-  if (o_.warn)
-    for (const auto& t : d.todo) o_.warn(quote(manifest_file) + ": still to fill in: " + t);
+  if (o_.warn && !d.todo.empty())
+    o_.warn(quote(manifest_file) + ": " + std::to_string(d.todo.size()) +
+            " items are placeholders (marked TODO): measure or check them before trusting results");
   return res;
 }
 
