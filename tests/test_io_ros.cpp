@@ -339,6 +339,81 @@ TEST_F(RosImport, McapVariantsBigEndianCdrBagDirectoryAndTopicNames) {
   fs::remove_all(dir);
 }
 
+// The truth as geometry_msgs/PoseStamped in NED/FRD (no twist: velocities by central
+// differences), and /tf_static positions through a chain of static frames.
+TEST_F(RosImport, PoseStampedTruthInNedAndChainedStaticFrames) {
+  std::vector<OutMessage> msgs;
+  const earth::LocalFrame frame(manifest_->origin);
+  for (const OutMessage& m : *msgs_) {
+    if (m.topic == "/tf_static") {
+      OutMessage tf = m;
+      // body_imu hangs off a mount frame: base_link -> mount (turned 90 deg about z) -> body_imu.
+      const Quat q(Eigen::AngleAxisd(kPi / 2, Vec3::UnitZ()));
+      const Vec3 mount(0.1, 0.0, 0.05);
+      for (auto& x : tf.tf)
+        if (x.child == "body_imu") {
+          const Vec3 p = Vec3(x.translation[0], x.translation[1], x.translation[2]);
+          const Vec3 local = q.inverse() * (p - mount);
+          x.parent = "mount";
+          x.translation = {local.x(), local.y(), local.z()};
+          ros::Transform y;
+          y.parent = "base_link";
+          y.child = "mount";
+          y.translation = {mount.x(), mount.y(), mount.z()};
+          y.rotation = xyzw(q);
+          tf.tf.push_back(y);
+          break;
+        }
+      msgs.push_back(tf);
+    } else if (m.topic == "/ground_truth/odom") {
+      OutMessage p = m;
+      p.kind = ros::MessageKind::kPoseStamped;
+      p.topic = "/ground_truth/pose";
+      p.pose.has_twist = false;
+      msgs.push_back(p);
+    } else {
+      msgs.push_back(m);
+    }
+  }
+  // Rewrite the truth poses in NED/FRD from the original truth.
+  TruthReader truth(manifest_->resolve(*manifest_->truth_file));
+  TruthRecord tr;
+  std::vector<TruthRecord> original;
+  for (OutMessage& m : msgs) {
+    if (m.topic != "/ground_truth/pose") continue;
+    ASSERT_TRUE(truth.next(tr));
+    original.push_back(tr);
+    const Vec3 p = frame.ned_from_geodetic(tr.lla);
+    m.pose.position = {p.x(), p.y(), p.z()};
+    m.pose.orientation = xyzw(Quat(dcm_from_euler(tr.rpy)));
+  }
+  const fs::path dir = scratch("pose");
+  fs::create_directories(dir);
+  write_ros2_db3(dir / "pose.db3", msgs);
+  ros::ImportOptions o = options();
+  o.truth_topic = "/ground_truth/pose";
+  o.convention = ros::PoseConvention::kNedFrd;
+  const fs::path out = dir / "out";
+  const ros::ImportResult r = ros::import_recording(dir / "pose.db3", out, o);
+  ASSERT_TRUE(r.truth);
+  const TruthData b = read_truth(out / "GINS.bin");
+  ASSERT_EQ(b.records.size(), original.size());
+  double dpos = 0, datt = 0, dvel = 0;
+  for (std::size_t k = 1; k + 1 < original.size(); ++k) {
+    const auto &x = original[k], &y = b.records[k];
+    dpos = std::max(dpos, (frame.ned_from_geodetic(x.lla) - frame.ned_from_geodetic(y.lla)).norm());
+    for (int i = 0; i < 3; ++i) datt = std::max(datt, std::abs(wrap_pi(x.rpy[i] - y.rpy[i])));
+    dvel = std::max(dvel, (x.v_ned - y.v_ned).norm());
+  }
+  EXPECT_LE(dpos, 1e-6);
+  EXPECT_LE(datt, 1e-12);
+  EXPECT_LE(dvel, 1e-5);  // central differences of 200 Hz positions vs the exact velocity [m/s] (1.1e-6)
+  EXPECT_GT(dvel, 0.0);
+  const Manifest d = load_manifest(out / "manifest.yaml", {});
+  EXPECT_LE((d.find("body-C1")->p_inV - manifest_->find("body-C1")->p_inV).norm(), 1e-12);
+  fs::remove_all(dir);
+}
+
 // --- bad input -----------------------------------------------------------------------
 
 /// Twenty IMU messages on /imu and five Odometry messages on /odom.
