@@ -118,13 +118,19 @@ def load_rows(dataset, module_file):
     return np.fromfile(os.path.join(os.path.dirname(dataset["manifest"]), module_file), dtype="<f8").reshape(-1, 7)
 
 
-@pytest.mark.parametrize("configuration,files", [
-    ("triple", ["left-wheel-imu/tri_C1_imu.bin", "right-wheel-imu/tri_C1_imu.bin", "body-imu/tri_C1_imu.bin"]),
+WHEEL_L, WHEEL_R, BODY = "left-wheel-imu/tri_C1_imu.bin", "right-wheel-imu/tri_C1_imu.bin", "body-imu/tri_C1_imu.bin"
+
+
+@pytest.mark.parametrize("configuration,files,settings,flags", [
+    ("triple", [WHEEL_L, WHEEL_R, BODY], {}, []),
+    ("body-wheel", [WHEEL_L, BODY], {"centralized": True, "speed": "own", "covariance_interval": 0.0},
+     ["--centralized", "--speed", "own", "--covariance-interval", "0"]),
 ])
-def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, cli_triple, configuration, files):
-    out, _ = cli_triple
-    nav = wheelins.Navigator(dataset["manifest"], configuration=configuration)
-    assert nav.modules == ["left-C1", "right-C1", "body-C1"]
+def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, tmp_path, configuration, files, settings,
+                                                                   flags):
+    cli("run", "-m", dataset["manifest"], "-c", configuration, "-o", tmp_path, "-q", *flags)
+    nav = wheelins.Navigator(dataset["manifest"], configuration=configuration, **settings)
+    assert len(nav.modules) == len(files)
     # The simulated manifest has no time offsets: merge by the file times, ties in module order.
     rows = [load_rows(dataset, f) for f in files]
     order = sorted((r[k, 0], i, k) for i, r in enumerate(rows) for k in range(len(r)))
@@ -136,13 +142,17 @@ def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, cli_t
         if n == half:
             state = nav.state
             assert state is not None and set(state) == set(wheelins.csv_columns())
-            P = nav.covariance("left-C1")
-            assert P.shape == (21, 21)
-            np.testing.assert_allclose(P, P.T, rtol=0, atol=1e-12 * np.abs(P).max())
-            assert np.all(np.linalg.eigvalsh(0.5 * (P + P.T)) > -1e-12 * np.abs(P).max())
             assert state["north_std_m"] > 0
+            if settings.get("centralized"):
+                with pytest.raises(wheelins.InputError, match="joint covariance"):
+                    nav.covariance(0)
+            else:
+                P = nav.covariance(nav.modules[0])
+                assert P.shape == (21, 21)
+                np.testing.assert_allclose(P, P.T, rtol=0, atol=1e-12 * np.abs(P).max())
+                assert np.all(np.linalg.eigvalsh(0.5 * (P + P.T)) > -1e-12 * np.abs(P).max())
     nav.finish()
-    same_as_csv(nav.trajectory, read_csv(out / "trajectory.csv"))
+    same_as_csv(nav.trajectory, read_csv(tmp_path / "trajectory.csv"))
 
 
 def test_errors_are_the_cli_messages(dataset, tmp_path):
