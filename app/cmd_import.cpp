@@ -3,10 +3,12 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
+#include "wheelins/util/progress.hpp"
 #include "wheelins/io/ros/import.hpp"
 #include "wheelins/nav/types.hpp"
 
@@ -16,7 +18,7 @@ using namespace wheelins;
 struct Options {
   std::string recording, out, odometry, truth, origin, convention = "enu", base_frame = "base_link";
   std::vector<std::string> topics;
-  bool receive_time = false, force = false;
+  bool receive_time = false, force = false, quiet = false;
 };
 
 earth::Geodetic parse_origin(const std::string& text) {
@@ -47,8 +49,14 @@ int run(const Options& o) {
   opt.base_frame = o.base_frame;
   opt.force = o.force;
   opt.warn = stderr_sink();
+  std::unique_ptr<Progress> bar;  // on a terminal: messages read of those to read
+  opt.progress = [&](std::uint64_t done, std::uint64_t total) {
+    if (!bar) bar = std::make_unique<Progress>("importing", total, !o.quiet);
+    bar->update(done);
+  };
 
   const ros::ImportResult r = ros::import_recording(o.recording, o.out, opt);
+  if (bar) bar->finish();
   std::cout << "imported " << o.recording << " (" << r.format << ")\n";
   for (const auto& t : r.imu)
     std::printf("  %-28s -> %s: %llu samples, %.3f .. %.3f s%s\n", t.topic.c_str(), t.file.string().c_str(),
@@ -88,6 +96,7 @@ const bool registered = cli::register_command(
           ->capture_default_str();
       sub.add_flag("--receive-time", o->receive_time,
                    "time = the recorder's receive time instead of the message header stamp");
+      sub.add_flag("--quiet,-q", o->quiet, "no progress line");
       sub.add_flag("--force,-f", o->force, "write into a non-empty directory, replacing files of the same names");
       return [o]() { return run(*o); };
     });

@@ -306,8 +306,12 @@ ImportResult Importer::run() {
   Track truth_track;  // its own: the truth topic may also be the --odometry topic
   std::vector<std::pair<double, PoseMessage>> poses;
   std::vector<Transform> transforms;
+  std::uint64_t total = 0, done = 0;
+  for (std::size_t i = 0; i < ts.size(); ++i)
+    if (wanted[i]) total += ts[i].count;
   Message m;
   while (reader_->next(m)) {
+    if (o_.progress && (++done & 4095) == 0) o_.progress(done, total);
     const std::size_t i = m.topic;
     if (imu_of[i] >= 0) {
       ImportedTopic& it = res.imu[static_cast<std::size_t>(imu_of[i])];

@@ -17,7 +17,9 @@
 // Nothing is left behind on an error (all files appear together at the end).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,6 +53,8 @@ struct ImportOptions {
   std::string base_frame = "base_link";  ///< the vehicle frame in /tf_static
   bool force = false;                    ///< write into a non-empty OUT, replacing our files
   WarningSink warn;
+  /// Called every few thousand messages with (messages read, messages to read; 0 if unknown).
+  std::function<void(std::uint64_t, std::uint64_t)> progress;
 };
 
 struct ImportedTopic {
