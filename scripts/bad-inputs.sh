@@ -242,3 +242,15 @@ cp "$T/right-wheel-imu/tri_C1_imu.bin" "$F/C1_imu.bin"; cp "$T/GINS.bin" "$T/odo
 case_ "wheelins manifest on the flat layout (C1_imu.bin, GINS.bin, odo.bin)" "$W" manifest "$F"
 case_ "wheelins run on it as drafted" "$W" run -m "$F/manifest.yaml" -q -o "$F/out" --formats csv
 chattr -i "$S/ro" 2>/dev/null; chmod 755 "$S/ro"
+imp() { rm -rf "$S/imported"; "$W" import "$1" --out "$S/imported" -q; }
+export -f imp
+printf 'hello\n' > "$S/notes.txt"; case_ "import: not a ROS recording" imp "$S/notes.txt"
+printf '#ROSBAG V2.0\nnot really\n' > "$S/broken.bag"; case_ "import: a broken ROS 1 bag" imp "$S/broken.bag"
+python3 -c "import sqlite3, sys; sqlite3.connect(sys.argv[1]).execute('create table t(x)')" "$S/other.db3"
+case_ "import: an sqlite3 file without the rosbag2 tables" imp "$S/other.db3"
+python3 -c "
+import struct, sys
+s = lambda t: struct.pack('<I', len(t)) + t
+h = s(b'ros2') + s(b'x')
+open(sys.argv[1], 'wb').write(b'\x89MCAP0\r\n' + b'\x01' + struct.pack('<Q', len(h)) + h + b'\x06' + struct.pack('<Q', 1000))" "$S/cut.mcap"
+case_ "import: an MCAP file cut inside a chunk" imp "$S/cut.mcap"
