@@ -18,7 +18,7 @@ packages=(
   gnuplot-nox parallel
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev
   libsqlite3-dev libzstd-dev liblz4-dev
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-yaml
 )
 for group in "$@"; do
   case $group in

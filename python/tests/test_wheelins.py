@@ -155,6 +155,31 @@ def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, tmp_p
     same_as_csv(nav.trajectory, read_csv(tmp_path / "trajectory.csv"))
 
 
+def test_navigator_from_module_specs(dataset, cli_triple):
+    """The manifest's content as a dict (no files named) navigates like the manifest file."""
+    yaml = pytest.importorskip("yaml")  # python3-yaml, installed by scripts/setup.sh
+    # Floats kept as their text: a manifest number of more than 17 digits converts to SI in
+    # long double precision (io/manifest.cpp), which a Python float cannot carry.
+    class Exact(yaml.SafeLoader):
+        pass
+
+    Exact.add_constructor("tag:yaml.org,2002:float", lambda loader, node: loader.construct_scalar(node))
+    with open(dataset["manifest"]) as f:
+        spec = yaml.load(f, Loader=Exact)
+    for m in spec["modules"]:
+        del m["file"]
+    nav = wheelins.Navigator(spec, configuration="triple")
+    files = [WHEEL_L, WHEEL_R, BODY]
+    rows = [load_rows(dataset, f) for f in files]
+    for _, i, k in sorted((r[k, 0], i, k) for i, r in enumerate(rows) for k in range(len(r))):
+        nav.push(i, rows[i][k][0], rows[i][k][1:4], rows[i][k][4:7])
+    nav.finish()
+    same_as_csv(nav.trajectory, read_csv(cli_triple[0] / "trajectory.csv"))
+    spec["modules"][0]["wheel_radius_m"] = -1
+    with pytest.raises(wheelins.InputError, match=r"modules\[0\].wheel_radius_m"):
+        wheelins.Navigator(spec)
+
+
 def test_errors_are_the_cli_messages(dataset, tmp_path):
     missing = tmp_path / "nothere.yaml"
     p = cli("run", "-m", missing, "-q", check=False)

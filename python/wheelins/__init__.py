@@ -17,6 +17,9 @@ wheelins.InputError (a ValueError) with the same MESSAGE. See docs/python.md.
 """
 
 import json as _json
+import os as _os
+import shutil as _shutil
+import tempfile as _tempfile
 
 import numpy as _np
 
@@ -140,7 +143,9 @@ def read_truth(truth, origin=None):
 
 class Navigator:
     """A run fed sample by sample: Navigator(manifest, configuration=..., chips=...,
-    modules=..., **filter_settings) (the options of run()), then push(module, t, gyro,
+    modules=..., **filter_settings) (the options of run()); manifest is a manifest file or
+    the module specs as a dict with the manifest's keys (docs/manifest.md; no "file"
+    needed). Then push(module, t, gyro,
     accel) for every IMU record in time order across the modules (module: a name or its
     index in .modules; t [s] as in the data file; gyro [rad/s], accel [m/s^2]; or the
     increments when the manifest says format: increment). The same samples through the
@@ -154,8 +159,25 @@ class Navigator:
     def __init__(self, manifest, configuration=None, chips=None, *, modules=None, config=None, **filter_settings):
         if isinstance(chips, str):
             chips = [c for c in chips.split(",") if c]
-        self._nav = _core.Navigator(manifest, configuration=configuration or "", chips=list(chips or []),
-                                    modules=list(modules or []), config=config, **filter_settings)
+        tmp = None
+        if isinstance(manifest, dict):
+            # Module specs without a file: the manifest's keys (docs/manifest.md) as a dict,
+            # handed to the manifest reader as JSON (which is YAML); no data file is read.
+            spec = dict(manifest)
+            spec.setdefault("format", "wheelins-manifest-1")
+            spec["modules"] = [dict(m, file=m.get("file", "(pushed samples)")) for m in spec.get("modules", [])]
+            spec.pop("truth", None)
+            spec.pop("odometer", None)
+            tmp = _tempfile.mkdtemp(prefix="wheelins-")
+            manifest = _os.path.join(tmp, "manifest (from a dict).yaml")
+            with open(manifest, "w") as f:
+                _json.dump(spec, f)
+        try:
+            self._nav = _core.Navigator(manifest, configuration=configuration or "", chips=list(chips or []),
+                                        modules=list(modules or []), config=config, **filter_settings)
+        finally:
+            if tmp:
+                _shutil.rmtree(tmp, ignore_errors=True)
 
     def push(self, module, t, gyro, accel):
         """One IMU record; False once the duration limit is reached (later samples are ignored)."""
