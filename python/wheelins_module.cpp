@@ -17,6 +17,7 @@
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/io/truth.hpp"
+#include "wheelins/run/input_checks.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
@@ -63,7 +64,7 @@ struct Settings {
   std::string configuration, config, speed;
   std::vector<std::string> chips, modules, formats;
   std::optional<bool> centralized, position_constraint, fault_handling;
-  double duration = 0.0, output_interval = -1.0, covariance_interval = -1.0;
+  std::optional<double> duration, output_interval, covariance_interval;
 };
 
 /// The run configuration as `wheelins run` builds it from a config file and its flags.
@@ -72,7 +73,16 @@ RunConfig run_config(const std::string& manifest, const Settings& s) {
   if (!manifest.empty()) cfg.manifest = manifest;
   if (cfg.manifest.empty())
     throw InputError("no dataset: give a manifest (or a run configuration naming one)");
-  if (!s.configuration.empty()) cfg.configuration = s.configuration;
+  // As wheelins run: the two ways of choosing the IMUs exclude each other.
+  if (!s.modules.empty() && !s.configuration.empty())
+    throw InputError("modules and configuration both given: modules names the IMUs itself; give one of them");
+  if (!s.modules.empty() && !s.chips.empty())
+    throw InputError("modules and chips both given: chips picks the chips of a configuration; with modules "
+                     "name the chips' modules (e.g. left-C2)");
+  if (!s.configuration.empty()) {
+    cfg.configuration = s.configuration;
+    cfg.modules.clear();  // the call's choice over the config file's modules
+  }
   if (!s.chips.empty()) cfg.chips = s.chips;
   if (!s.modules.empty()) cfg.modules = s.modules;
   if (!s.formats.empty()) {
@@ -83,14 +93,10 @@ RunConfig run_config(const std::string& manifest, const Settings& s) {
   if (s.centralized) cfg.nav.fusion.centralized = *s.centralized;
   if (s.position_constraint) cfg.nav.fusion.position_constraint = *s.position_constraint;
   if (s.fault_handling) cfg.nav.faults.enabled = *s.fault_handling;
-  if (s.duration > 0) cfg.max_duration = s.duration;
-  if (s.output_interval >= 0) cfg.nav.output_interval = s.output_interval;
-  if (s.covariance_interval >= 0) {
-    if (s.covariance_interval > 0.5)
-      throw InputError("covariance_interval " + io_detail::format_double(s.covariance_interval) +
-                       ": must be in [0, 0.5] s");
-    cfg.nav.covariance_interval = s.covariance_interval;
-  }
+  // Ranges (NaN included) are checked with the request (validate_run_request).
+  if (s.duration) cfg.max_duration = *s.duration;
+  if (s.output_interval) cfg.nav.output_interval = *s.output_interval;
+  if (s.covariance_interval) cfg.nav.covariance_interval = *s.covariance_interval;
   return cfg;
 }
 
@@ -117,7 +123,8 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
               const std::vector<std::string>& modules, const py::object& config, const py::object& out,
               const std::vector<std::string>& formats, const std::string& speed, std::optional<bool> centralized,
               std::optional<bool> position_constraint, std::optional<bool> fault_handling, bool evaluate,
-              double duration, double output_interval, double covariance_interval, bool force, bool progress) {
+              std::optional<double> duration, std::optional<double> output_interval,
+              std::optional<double> covariance_interval, bool force, bool progress) {
   Settings s{configuration, text(config).value_or(""), speed, chips, modules, formats,
              centralized, position_constraint, fault_handling, duration, output_interval, covariance_interval};
   RunConfig cfg = run_config(text(manifest).value_or(""), s);
@@ -252,30 +259,42 @@ py::dict simulate(const py::object& out, const std::vector<std::string>& setting
 
 // ---------------------------------------------------------------------- navigator
 
-/// A run fed sample by sample: the request `wheelins run` makes (without files), the
-/// samples made from the pushed records by io/imu_file.hpp imu_sample() as the file
-/// reader makes them, the duration limit applied as run_navigation() applies it.
+/// A run fed sample by sample: the request `wheelins run` makes (without files, validated
+/// as run_navigation() validates it), the samples made from the pushed records by
+/// io/imu_file.hpp imu_sample() as the file reader makes them and passed through the run's
+/// input checks (run/input_checks.hpp), the duration limit applied as run_navigation()
+/// applies it.
 class StreamNavigator {
  public:
   StreamNavigator(const py::object& manifest, const std::string& configuration, const std::vector<std::string>& chips,
                   const std::vector<std::string>& modules, const py::object& config, const std::string& speed,
                   std::optional<bool> centralized, std::optional<bool> position_constraint,
-                  std::optional<bool> fault_handling, double duration, double output_interval,
-                  double covariance_interval) {
+                  std::optional<bool> fault_handling, std::optional<double> duration,
+                  std::optional<double> output_interval, std::optional<double> covariance_interval) {
     Settings s{configuration, text(config).value_or(""), speed, chips, modules, {},
                centralized, position_constraint, fault_handling, duration, output_interval, covariance_interval};
     req_ = make_run_request(run_config(text(manifest).value_or(""), s), stderr_sink());
+    req_.output_dir.clear();
+    validate_run_request(req_);
+    tracks_.reserve(req_.modules.size());  // (InputChecks keeps a reference to its spec)
     for (const auto& name : req_.modules) {
       const ModuleSpec* spec = req_.manifest.find(name);
-      if (!spec) throw InputError("'" + req_.manifest.path.string() + "': no module named '" + name + "'");
-      Track t;
-      t.options = imu_read_options(*spec);
-      tracks_.push_back(t);
+      tracks_.push_back(Track{imu_read_options(*spec), 0.0, 0,
+                              InputChecks(*spec, req_.manifest, req_.nav.faults.enabled, stderr_sink(),
+                                          "module '" + name + "' (pushed samples)")});
     }
     NavigatorOptions nav = req_.nav;
     nav.module_records = false;  // as a run that writes no subsystem files
     nav_ = std::make_unique<Navigator>(req_.manifest, req_.modules, nav, [this](int stream, const TrajectoryRecord& r) {
-      if (stream == 0) records_.push_back(r);
+      if (stream != 0 || non_finite_) return;
+      // As the run driver: a record that is not finite is never passed on.
+      if (!(std::isfinite(r.t) && r.p_inN.allFinite() && r.v_inN.allFinite() && r.rpy.allFinite() &&
+            r.p_std.allFinite() && r.v_std.allFinite() && r.rpy_std.allFinite())) {
+        non_finite_ = true;
+        non_finite_t_ = r.t;
+        return;
+      }
+      records_.push_back(r);
     });
   }
 
@@ -321,20 +340,28 @@ class StreamNavigator {
     row.t = t;
     row.gyro = Vec3(gyro[0], gyro[1], gyro[2]);
     row.accel = Vec3(accel[0], accel[1], accel[2]);
-    const ImuSample s = imu_sample(row, dt, tr.options);
+    ImuSample s = imu_sample(row, dt, tr.options);
     if (s.t < last_t_)
       throw InputError(where + " (0-based): time " + io_detail::format_double(s.t) + " is before the last sample pushed (" +
                        io_detail::format_double(last_t_) + "): push the modules' samples in time order");
     tr.prev_t = t;
-    ++tr.count;
+    const std::uint64_t index = tr.count++;
     last_t_ = s.t;
+    // The run's input checks (run/input_checks.hpp): a sample beyond the sensor range is
+    // left out (its interval goes to the next one), the rate, format and static period checked.
+    if (!tr.checks.admit(s, index)) return !stopped_;
     nav_->process(i, s);
+    if (non_finite_)
+      throw InputError("the navigation became non-finite (the vehicle solution) by t = " +
+                       io_detail::format_double(non_finite_t_) + " s: the filter diverged (an input or a setting "
+                       "outside what the checks catch)");
     if (req_.max_duration > 0 && nav_->navigating() && s.t - nav_->stats().t_start >= req_.max_duration) stopped_ = true;
     return !stopped_;
   }
 
   void finish() {
     if (finished_) return;
+    for (auto& tr : tracks_) tr.checks.finish();
     if (!nav_->navigating()) {
       char period[96];
       std::snprintf(period, sizeof period, "[%.3f, %.3f] s", req_.manifest.static_start, req_.manifest.static_end);
@@ -381,13 +408,15 @@ class StreamNavigator {
     ImuReadOptions options;
     double prev_t = 0.0;
     std::uint64_t count = 0;
+    InputChecks checks;
   };
   RunRequest req_;
   std::vector<Track> tracks_;
   std::unique_ptr<Navigator> nav_;
   std::vector<TrajectoryRecord> records_;
   double last_t_ = -std::numeric_limits<double>::infinity();
-  bool stopped_ = false, finished_ = false;
+  bool stopped_ = false, finished_ = false, non_finite_ = false;
+  double non_finite_t_ = 0.0;
 };
 
 }  // namespace
@@ -412,8 +441,8 @@ PYBIND11_MODULE(_core, m) {
         py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("out") = py::none(),
         py::arg("formats") = std::vector<std::string>{}, py::arg("speed") = "", py::arg("centralized") = py::none(),
         py::arg("position_constraint") = py::none(), py::arg("fault_handling") = py::none(), py::arg("evaluate") = true,
-        py::arg("duration") = 0.0, py::arg("output_interval") = -1.0, py::arg("covariance_interval") = -1.0,
-        py::arg("force") = false, py::arg("progress") = false);
+        py::arg("duration") = py::none(), py::arg("output_interval") = py::none(),
+        py::arg("covariance_interval") = py::none(), py::arg("force") = false, py::arg("progress") = false);
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
         py::arg("origin") = py::none(), py::arg("series") = false);
@@ -424,12 +453,12 @@ PYBIND11_MODULE(_core, m) {
   py::class_<StreamNavigator>(m, "Navigator")
       .def(py::init<const py::object&, const std::string&, const std::vector<std::string>&, const std::vector<std::string>&,
                     const py::object&, const std::string&, std::optional<bool>, std::optional<bool>, std::optional<bool>,
-                    double, double, double>(),
+                    std::optional<double>, std::optional<double>, std::optional<double>>(),
            py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
            py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("speed") = "",
            py::arg("centralized") = py::none(), py::arg("position_constraint") = py::none(),
-           py::arg("fault_handling") = py::none(), py::arg("duration") = 0.0, py::arg("output_interval") = -1.0,
-           py::arg("covariance_interval") = -1.0)
+           py::arg("fault_handling") = py::none(), py::arg("duration") = py::none(),
+           py::arg("output_interval") = py::none(), py::arg("covariance_interval") = py::none())
       .def("push", &StreamNavigator::push, py::arg("module"), py::arg("t"), py::arg("gyro"), py::arg("accel"))
       .def("finish", &StreamNavigator::finish)
       .def("covariance", &StreamNavigator::covariance, py::arg("module") = 0)

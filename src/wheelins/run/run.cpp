@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <set>
 
+#include "wheelins/run/input_checks.hpp"
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/output_dir.hpp"
@@ -40,197 +41,26 @@ std::string fmt(double v, const char* f = "%.4g") {
   return buf;
 }
 
-/// One module's samples as they enter the navigator, with the checks a navigation user
-/// expects of them (docs/faults.md, "Input checks"):
-///  * a sample beyond the sensor range (the manifest's gyro_range_dps / accel_range_m_s2,
-///    else kDefaultGyroLimit / kDefaultAccelLimit) is a fault: left out, its interval given
-///    to the next sample (isolate and continue), or an error without fault handling;
-///  * the records' real rate (median interval of the first ones) matches rate_hz;
-///  * in the static period, the data are increments or rates as declared (the specific force
-///    read both ways), the IMU does not turn, and the specific force is gravity.
-/// A failed check is an InputError naming the file and the figure.
+/// One module's file through the input checks (run/input_checks.hpp).
 class CheckedStream final : public ImuStream {
  public:
   CheckedStream(std::unique_ptr<ImuFileReader> reader, const ModuleSpec& spec, const Manifest& m,
                 bool isolate, const WarningSink& warn)
-      : reader_(std::move(reader)), spec_(spec), isolate_(isolate), warn_(warn),
-        static_start_(m.static_start), static_end_(m.static_end), gravity_(m.gravity_or_default()),
-        gravity_given_(m.gravity.has_value()) {
-    gyro_limit_ = spec.gyro_range > 0.0 ? 1.05 * spec.gyro_range : kDefaultGyroLimit;
-    accel_limit_ = spec.accel_range > 0.0 ? 1.05 * spec.accel_range : kDefaultAccelLimit;
-  }
+      : reader_(std::move(reader)), checks_(spec, m, isolate, warn, quote(reader_->file())) {}
 
   bool next(ImuSample& s) override {
-    while (reader_->next(s)) {
-      check_rate(s);
-      // The format first (from the first static samples, before any is judged by range):
-      // rates read as increments, or the reverse, are off by the rate in every figure.
-      if (!format_checked_) {
-        if (s.t >= static_start_ && s.t <= static_end_) {
-          fmt_sum_ += s.dvel.norm();
-          fmt_time_ += s.dt;
-          if (++fmt_n_ >= 100) check_format();
-        } else if (s.t > static_end_) {
-          check_format();
-        }
-      }
-      const double dt = s.dt;
-      const double w = s.dtheta.cwiseAbs().maxCoeff() / dt, f = s.dvel.cwiseAbs().maxCoeff() / dt;
-      if (!(w <= gyro_limit_) || !(f <= accel_limit_)) {
-        out_of_range(s, w > gyro_limit_);
-        continue;
-      }
-      if (carry_ > 0.0) {  // the samples left out: their interval at this sample's rate
-        const double k = (s.dt + carry_) / s.dt;
-        s.dtheta *= k;
-        s.dvel *= k;
-        s.dt += carry_;
-        carry_ = 0.0;
-      }
-      if (!static_checked_) {
-        if (s.t >= static_start_ && s.t <= static_end_) {
-          sum_dtheta_ += s.dtheta;
-          sum_dvel_ += s.dvel;
-          static_time_ += s.dt;
-          ++static_n_;
-        } else if (s.t > static_end_) {
-          check_static();
-        }
-      }
-      return true;
-    }
-    if (!rate_checked_) finish_rate_check();
-    if (!format_checked_) check_format();
-    if (!static_checked_) check_static();
+    while (reader_->next(s))
+      if (checks_.admit(s, reader_->index())) return true;
+    checks_.finish();
     return false;
   }
 
-  std::uint64_t dropped() const { return dropped_; }
+  std::uint64_t dropped() const { return checks_.dropped(); }
   const ImuFileReader& reader() const { return *reader_; }
 
  private:
-  void out_of_range(const ImuSample& s, bool gyro) {
-    const double lim = gyro ? gyro_limit_ : accel_limit_;
-    const Vec3 v = (gyro ? s.dtheta : s.dvel) / s.dt;
-    std::string what = std::string(gyro ? "gyro" : "accelerometer") + " reading " +
-                       fmt(v.cwiseAbs().maxCoeff(), "%.4g") + (gyro ? " rad/s" : " m/s^2") +
-                       " beyond the sensor range " + fmt(lim, "%.4g") + (gyro ? " rad/s" : " m/s^2") +
-                       ((gyro ? spec_.gyro_range : spec_.accel_range) > 0.0
-                            ? std::string(" (the manifest's range + 5 %)")
-                            : std::string(" (no range in the manifest: the physical limit)"));
-    const std::string where = quote(reader_->file()) + ": record " + std::to_string(reader_->index()) +
-                              " (0-based, t=" + format_double(s.t) + "): ";
-    if (!isolate_)
-      throw InputError(where + what + "; with fault handling on, such samples are left out");
-    ++dropped_;
-    carry_ += s.dt;
-    if (first_drop_t_ < 0) first_drop_t_ = s.t;
-    // Reported once the format is known to be right (else that error comes first).
-    if (warn_ && format_checked_ && ++warned_ <= 5)
-      warn_(where + what + ": sample left out (" + spec_.name + ")");
-    else if (warn_ && format_checked_ && warned_ == 6)
-      warn_(quote(reader_->file()) + ": further samples beyond the range are left out and counted");
-  }
-
-  void check_rate(const ImuSample& s) {
-    if (rate_checked_) return;
-    if (n_intervals_++ == 0) return;  // the first sample's dt is the nominal one
-    intervals_.push_back(s.dt);
-    if (intervals_.size() >= 100) finish_rate_check();
-  }
-
-  void finish_rate_check() {
-    rate_checked_ = true;
-    if (intervals_.size() < 10) return;
-    std::nth_element(intervals_.begin(), intervals_.begin() + intervals_.size() / 2, intervals_.end());
-    const double median = intervals_[intervals_.size() / 2];
-    const double real = 1.0 / median;
-    if (real < spec_.rate_hz / 1.25 || real > spec_.rate_hz * 1.25)
-      throw InputError(quote(reader_->file()) + ": the records are " + fmt(median, "%.4g") +
-                       " s apart (median of the first " + std::to_string(intervals_.size()) +
-                       " intervals), i.e. " + fmt(real, "%.4g") + " Hz, but the manifest declares " +
-                       "rate_hz " + format_double(spec_.rate_hz) + " for module '" + spec_.name + "'");
-    intervals_.clear();
-    intervals_.shrink_to_fit();
-  }
-
-  std::string period() const {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "the static period [%.3f, %.3f] s", static_start_, static_end_);
-    return buf;
-  }
-
-  void check_format() {
-    format_checked_ = true;
-    if (fmt_n_ < 10 || !(fmt_time_ > 0.0)) return;  // too short to judge
-    const std::string file = quote(reader_->file());
-    const std::string period = this->period();
-    const double fmag = fmt_sum_ / fmt_time_;  // mean |f| read as declared [m/s^2]
-    const bool rates = spec_.format == SampleFormat::kRate;
-    const double other = rates ? fmag * spec_.rate_hz : fmag / spec_.rate_hz;  // read the other way
-    const double g = gravity_;
-    auto plausible = [&](double x) { return x > 0.5 * g && x < 2.0 * g; };
-    if (!plausible(fmag)) {
-      if (plausible(other))
-        throw InputError(file + ": in " + period + " the accelerometer reads " + fmt(fmag, "%.4g") +
-                         " m/s^2 taken as " + (rates ? "rates" : "increments") + ", " + fmt(other, "%.4g") +
-                         " m/s^2 taken as " + (rates ? "increments" : "rates") + " (gravity " +
-                         fmt(g, "%.4g") + "): the file holds " + (rates ? "increments" : "rates") +
-                         ", the manifest says format: " + to_string(spec_.format) + " (module '" +
-                         spec_.name + "')");
-      throw InputError(file + ": in " + period + " the mean specific force is " + fmt(fmag, "%.4g") +
-                       " m/s^2, far from gravity " + fmt(g, "%.4g") + " m/s^2 (module '" + spec_.name +
-                       "'): wrong units (g instead of m/s^2?), or not a 7-column IMU file");
-    }
-  }
-
-  void check_static() {
-    static_checked_ = true;
-    if (static_n_ < 10 || !(static_time_ > 0.0)) return;  // too short to judge
-    const std::string file = quote(reader_->file());
-    const std::string period = this->period();
-    const double g = gravity_;
-    const double turn = (sum_dtheta_ / static_time_).norm();
-    if (turn > kStaticMaxRate)
-      throw InputError(file + ": the IMU turns at " + fmt(turn / kDeg, "%.3g") + " deg/s on average in " +
-                       period + " (module '" + spec_.name + "'; at rest it reads the earth rate and "
-                       "its bias, well under " + fmt(kStaticMaxRate / kDeg, "%.3g") +
-                       " deg/s): the vehicle moves there; move static_period_s to where it stands");
-    const double fmean = (sum_dvel_ / static_time_).norm();
-    if (std::abs(fmean - g) > kGravityTolerance * g)
-      throw InputError(file + ": the mean specific force in " + period + " is " + fmt(fmean, "%.4g") +
-                       " m/s^2, gravity " + (gravity_given_ ? "(gravity_m_s2 of the manifest) " : "at the origin ") +
-                       fmt(g, "%.4g") + " m/s^2, " + fmt(100.0 * std::abs(fmean - g) / g, "%.2g") +
-                       " % apart (module '" + spec_.name + "'): the vehicle accelerates or shakes "
-                       "there, or gravity_m_s2 / the accelerometer scale is wrong");
-  }
-
- public:
-  static constexpr double kDefaultGyroLimit = 20000.0 * kDeg;  ///< [rad/s] no range declared
-  static constexpr double kDefaultAccelLimit = 2000.0;         ///< [m/s^2] about 200 g
-  static constexpr double kStaticMaxRate = 5.0 * kDeg;         ///< mean rate at rest [rad/s]
-  static constexpr double kGravityTolerance = 0.05;            ///< |f| at rest vs gravity
-
- private:
   std::unique_ptr<ImuFileReader> reader_;
-  const ModuleSpec& spec_;
-  bool isolate_;
-  WarningSink warn_;
-  double gyro_limit_ = 0.0, accel_limit_ = 0.0;
-  double carry_ = 0.0, first_drop_t_ = -1.0;
-  std::uint64_t dropped_ = 0;
-  std::uint64_t n_intervals_ = 0;
-  std::vector<double> intervals_;
-  bool rate_checked_ = false;
-  double static_start_, static_end_, gravity_;
-  bool gravity_given_;
-  bool static_checked_ = false;
-  bool format_checked_ = false;
-  double fmt_sum_ = 0.0, fmt_time_ = 0.0;
-  std::uint64_t fmt_n_ = 0, warned_ = 0;
-  Vec3 sum_dtheta_ = Vec3::Zero(), sum_dvel_ = Vec3::Zero();
-  double static_time_ = 0.0;
-  std::uint64_t static_n_ = 0;
+  InputChecks checks_;
 };
 
 bool finite(const TrajectoryRecord& r) {
