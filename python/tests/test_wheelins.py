@@ -155,6 +155,26 @@ def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, tmp_p
     same_as_csv(nav.trajectory, read_csv(tmp_path / "trajectory.csv"))
 
 
+def test_streaming_navigator_applies_the_runs_input_checks(dataset, tmp_path):
+    """A gyro sample beyond the sensor range: the run leaves it out (fault handling on) and
+    so does the navigator, to the last digit."""
+    import shutil
+    sim = os.path.dirname(dataset["manifest"])
+    copy = tmp_path / "spike"
+    shutil.copytree(sim, copy)
+    rows = load_rows(dataset, WHEEL_L).copy()
+    rows[5000, 2] = 1e6  # rad/s
+    rows.astype("<f8").tofile(copy / WHEEL_L)
+    p = cli("run", "-m", copy / "manifest.yaml", "-c", "body-wheel", "-o", tmp_path / "out", "-q")
+    assert "beyond the sensor range" in p.stderr or "beyond the sensor range" in p.stdout
+    nav = wheelins.Navigator(copy / "manifest.yaml", configuration="body-wheel")
+    data = [rows, load_rows(dataset, BODY)]
+    for _, i, k in sorted((r[k, 0], i, k) for i, r in enumerate(data) for k in range(len(r))):
+        nav.push(i, data[i][k][0], data[i][k][1:4], data[i][k][4:7])
+    nav.finish()
+    same_as_csv(nav.trajectory, read_csv(tmp_path / "out" / "trajectory.csv"))
+
+
 def test_navigator_from_module_specs(dataset, cli_triple):
     """The manifest's content as a dict (no files named) navigates like the manifest file."""
     yaml = pytest.importorskip("yaml")  # python3-yaml, installed by scripts/setup.sh
