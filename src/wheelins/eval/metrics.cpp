@@ -2,6 +2,8 @@
 // drift rate over distance segments, heading RMSE, NEES) and evaluate() on whole files.
 #include "wheelins/eval/metrics.hpp"
 
+#include "wheelins/io/text_util.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
@@ -345,28 +347,7 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
 
 namespace {
 
-void json_string(std::string& o, const std::string& s) {
-  o += '"';
-  for (char c : s) {
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\t': o += "\\t"; break;
-      case '\r': o += "\\r"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          static const char* hex = "0123456789abcdef";
-          o += "\\u00";
-          o += hex[(c >> 4) & 0xf];
-          o += hex[c & 0xf];
-        } else {
-          o += c;
-        }
-    }
-  }
-  o += '"';
-}
+void json_string(std::string& o, const std::string& s) { o += io_detail::json_quote(s); }
 
 void json_number(std::string& o, double v) {
   if (!std::isfinite(v)) {

@@ -26,6 +26,30 @@ WarningSink stderr_sink() {
 
 namespace io_detail {
 
+std::string json_quote(std::string_view s) {
+  std::string o = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\t': o += "\\t"; break;
+      case '\r': o += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          static const char* hex = "0123456789abcdef";
+          o += "\\u00";
+          o += hex[(c >> 4) & 0xf];
+          o += hex[c & 0xf];
+        } else {
+          o += c;
+        }
+    }
+  }
+  o += '"';
+  return o;
+}
+
 std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
 
 std::filesystem::path unique_partial(const std::filesystem::path& file) {

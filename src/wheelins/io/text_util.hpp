@@ -14,6 +14,9 @@ namespace wheelins::io_detail {
 /// "'path'" as every I/O message names a file.
 std::string quote(const std::filesystem::path& p);
 
+/// `s` as a JSON string literal, quotes included (", \\ and control characters escaped).
+std::string json_quote(std::string_view s);
+
 /// Shortest decimal text that parses back to exactly `v` ("0.097", "200", "100000",
 /// "0.000001"; scientific only outside [1e-5, 1e16)).
 std::string format_double(double v);

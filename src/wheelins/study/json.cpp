@@ -5,41 +5,11 @@
 #include <cmath>
 
 #include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/text_util.hpp"
 
 namespace wheelins::study {
 
-std::string json_quote(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"':
-        o += "\\\"";
-        break;
-      case '\\':
-        o += "\\\\";
-        break;
-      case '\n':
-        o += "\\n";
-        break;
-      case '\t':
-        o += "\\t";
-        break;
-      case '\r':
-        o += "\\r";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          static const char* hex = "0123456789abcdef";
-          o += "\\u00";
-          o += hex[(c >> 4) & 0xf];
-          o += hex[c & 0xf];
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o + "\"";
-}
+std::string json_quote(const std::string& s) { return io_detail::json_quote(s); }
 
 void JsonWriter::item(const char* key) {
   if (first_.empty()) return;
