@@ -16,6 +16,15 @@ namespace wheelins {
 enum StateIndex : int { P = 0, V = 3, PHI = 6, BG = 9, BA = 12, SG = 15, SA = 18 };
 constexpr int kStateDim = 21;
 
+/// The name of error state k ("dr_x" .. "sa_z"), as reports write it; "?" out of range.
+inline const char* error_state_name(int k) {
+  static const char* names[kStateDim] = {"dr_x", "dr_y", "dr_z", "dv_x", "dv_y", "dv_z",
+                                         "phi_x", "phi_y", "phi_z", "bg_x", "bg_y", "bg_z",
+                                         "ba_x", "ba_y", "ba_z", "sg_x", "sg_y", "sg_z",
+                                         "sa_x", "sa_y", "sa_z"};
+  return k >= 0 && k < kStateDim ? names[k] : "?";
+}
+
 using Vec21 = Eigen::Matrix<double, kStateDim, 1>;
 using Mat21 = Eigen::Matrix<double, kStateDim, kStateDim>;
 

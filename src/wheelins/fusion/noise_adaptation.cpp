@@ -149,15 +149,6 @@ void NoiseAdaptation::check_excursions(int i, double t) {
     }
 }
 
-namespace {
-const char* state_name(int k) {
-  static const char* names[kStateDim] = {"dr_x", "dr_y", "dr_z", "dv_x", "dv_y", "dv_z",
-                                         "phi_x", "phi_y", "phi_z", "bg_x", "bg_y", "bg_z",
-                                         "ba_x", "ba_y", "ba_z", "sg_x", "sg_y", "sg_z",
-                                         "sa_x", "sa_y", "sa_z"};
-  return k >= 0 && k < kStateDim ? names[k] : "?";
-}
-}  // namespace
 
 ModuleNoiseReport NoiseAdaptation::report(int i) const {
   const State& st = st_[i];
@@ -217,7 +208,7 @@ ModuleNoiseReport NoiseAdaptation::report(int i) const {
     const char* u = gyro_bias ? "deg/h" : (accel_bias ? "m/s^2" : "ppm");
     std::snprintf(w, sizeof w,
                   "%s: estimate %s at %.1f s is %.4g %s, beyond 3 sigma of its prior %.4g %s%s",
-                  r.module.c_str(), state_name(x.state), x.t, x.value * unit, u,
+                  r.module.c_str(), error_state_name(x.state), x.t, x.value * unit, u,
                   x.prior_sigma * unit, u,
                   (accel_bias && r.wheel && x.state != BA)
                       ? " (a Wheel-IMU's accelerometer bias in the wheel plane looks like the "

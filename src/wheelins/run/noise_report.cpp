@@ -27,13 +27,6 @@ std::string vec(const Vec3& v, int digits = 4) {
   return "[" + num(v.x(), digits) + ", " + num(v.y(), digits) + ", " + num(v.z(), digits) + "]";
 }
 
-const char* state_name(int k) {
-  static const char* names[kStateDim] = {"dr_x", "dr_y", "dr_z", "dv_x", "dv_y", "dv_z",
-                                         "phi_x", "phi_y", "phi_z", "bg_x", "bg_y", "bg_z",
-                                         "ba_x", "ba_y", "ba_z", "sg_x", "sg_y", "sg_z",
-                                         "sa_x", "sa_y", "sa_z"};
-  return k >= 0 && k < kStateDim ? names[k] : "?";
-}
 
 const ModuleSpec* spec_of(const Manifest& m, const std::string& name) { return m.find(name); }
 
@@ -107,7 +100,7 @@ std::string noise_report_yaml(const std::vector<ModuleNoiseReport>& reports,
     consistency(o, "velocity", r.velocity);
     consistency(o, "position", r.position);
     o << "    not_estimated: [";
-    for (std::size_t k = 0; k < r.held.size(); ++k) o << (k ? ", " : "") << state_name(r.held[k]);
+    for (std::size_t k = 0; k < r.held.size(); ++k) o << (k ? ", " : "") << error_state_name(r.held[k]);
     o << "]  # held at 0 (docs/filter.md 13.4: yaw-rate scale factors, the axle accelerometer's)\n";
     o << "    beyond_3_sigma:";
     if (r.excursions.empty()) o << " []";
@@ -115,7 +108,7 @@ std::string noise_report_yaml(const std::vector<ModuleNoiseReport>& reports,
     for (const PriorExcursion& x : r.excursions) {
       const bool gb = x.state >= BG && x.state < BG + 3, ab = x.state >= BA && x.state < BA + 3;
       const double u = gb ? 3600.0 / kDeg : (ab ? 1.0 : 1e6);
-      o << "      - {state: " << state_name(x.state) << ", t_s: " << num(x.t, 10) << ", value: "
+      o << "      - {state: " << error_state_name(x.state) << ", t_s: " << num(x.t, 10) << ", value: "
         << num(x.value * u) << ", prior_sigma: " << num(x.prior_sigma * u) << ", unit: "
         << (gb ? "deg/h" : (ab ? "m/s^2" : "ppm")) << "}\n";
     }
