@@ -15,6 +15,7 @@
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/sim/simulator.hpp"
+#include "nav_test_util.hpp"
 
 using namespace wheelins;
 namespace fs = std::filesystem;
@@ -28,18 +29,7 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
-// Feeds `modules`' samples (merged by time) to `navigator` while their time is below t_end.
-void replay(Navigator& navigator, const Manifest& m, const std::vector<std::string>& modules,
-            double t_end = std::numeric_limits<double>::infinity()) {
-  std::vector<std::unique_ptr<ImuStream>> readers;
-  for (const auto& name : modules)
-    readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
-                                                      imu_read_options(*m.find(name))));
-  ImuMerger merger(std::move(readers));
-  std::size_t i = 0;
-  ImuSample s;
-  while (merger.next(i, s) && s.t < t_end) navigator.process(static_cast<int>(i), s);
-}
+using test::replay;
 
 struct Outcome {
   eval::EvalResult eval;

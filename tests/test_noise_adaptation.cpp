@@ -18,6 +18,7 @@
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/sim/simulator.hpp"
+#include "nav_test_util.hpp"
 
 using namespace wheelins;
 namespace fs = std::filesystem;
@@ -68,14 +69,7 @@ Outcome navigate(const fs::path& manifest_file, const std::vector<std::string>& 
     if (stream == 0 && (traj.records.empty() || rec.t >= traj.records.back().t + 0.05 - 1e-9))
       traj.records.push_back(rec);
   });
-  std::vector<std::unique_ptr<ImuStream>> readers;
-  for (const auto& name : modules)
-    readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
-                                                      imu_read_options(*m.find(name))));
-  ImuMerger merger(std::move(readers));
-  std::size_t i = 0;
-  ImuSample s;
-  while (merger.next(i, s)) navigator.process(static_cast<int>(i), s);
+  test::replay(navigator, m, modules);
   navigator.finish();
   Outcome o;
   const TruthData truth = read_truth(manifest_file.parent_path() / "GINS.bin");
@@ -204,14 +198,7 @@ TEST_F(NoiseAdaptationEndToEnd, YawRateScaleFactorsAreHeldInBothFilters) {
     nav.earth_rotation = m.earth_rotation;
     nav.noise.enabled = true;
     Navigator navigator(m, modules, nav, [](int, const TrajectoryRecord&) {});
-    std::vector<std::unique_ptr<ImuStream>> readers;
-    for (const auto& name : modules)
-      readers.push_back(std::make_unique<ImuFileReader>(m.resolve(m.find(name)->file),
-                                                        imu_read_options(*m.find(name))));
-    ImuMerger merger(std::move(readers));
-    std::size_t i = 0;
-    ImuSample s;
-    while (merger.next(i, s) && s.t < m.static_end + 200.0) navigator.process(static_cast<int>(i), s);
+    test::replay(navigator, m, modules, m.static_end + 200.0);
     for (int k = 0; k < navigator.subsystem_count(); ++k) {
       const Subsystem& sub = navigator.subsystem(k);
       const ModuleNoiseReport rep = navigator.noise_report(k);
