@@ -72,19 +72,6 @@ Probe probe_imu(const fs::path& file) {
   return p;
 }
 
-/// The time the first wheel gyro reading shows the wheel rolling (nullopt: none in the scan).
-std::optional<double> motion_from_wheel(const fs::path& file, double t_from) {
-  ImuReadOptions o;
-  o.gap_factor = std::numeric_limits<double>::infinity();
-  ImuFileReader r(file, o);
-  ImuSample s;
-  while (r.next(s)) {
-    if (s.t < t_from) continue;
-    if (s.t > t_from + kScanSeconds) return std::nullopt;
-    if (r.row().gyro.norm() > kMoveWheelRate) return s.t;
-  }
-  return std::nullopt;
-}
 
 std::optional<double> motion_from_odometer(const fs::path& file, double t_from) {
   OdoReader r(file);
@@ -240,6 +227,19 @@ std::vector<Found> find_public(const fs::path& dir) {
 }
 
 }  // namespace
+
+std::optional<double> motion_from_wheel(const fs::path& file, double t_from) {
+  ImuReadOptions o;
+  o.gap_factor = std::numeric_limits<double>::infinity();
+  ImuFileReader r(file, o);
+  ImuSample s;
+  while (r.next(s)) {
+    if (s.t < t_from) continue;
+    if (s.t > t_from + kScanSeconds) return std::nullopt;
+    if (r.row().gyro.norm() > kMoveWheelRate) return s.t;
+  }
+  return std::nullopt;
+}
 
 ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_file) {
   std::error_code ec;

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,10 @@ struct ManifestDraft {
   std::vector<std::string> facts;  ///< what was read from the data, one line each
   std::vector<std::string> todo;   ///< what the user must still fill in, one line each
 };
+
+/// The time at which a Wheel-IMU file's gyro first shows the wheel rolling (0.5 rad/s),
+/// scanning at most 900 s after t_from; nullopt if it does not within that.
+std::optional<double> motion_from_wheel(const std::filesystem::path& file, double t_from);
 
 /// Inspects `dir` and drafts a manifest meant to be written to `manifest_file`.
 /// Throws InputError naming the directory when it matches neither layout, and the

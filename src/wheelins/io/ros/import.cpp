@@ -12,6 +12,7 @@
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/imu_file.hpp"
+#include "wheelins/io/manifest_draft.hpp"
 #include "wheelins/io/odometer.hpp"
 #include "wheelins/io/ros/messages.hpp"
 #include "wheelins/io/text_util.hpp"
@@ -196,20 +197,6 @@ void Importer::apply_tf(ImportResult& res, const std::vector<Transform>& tf) con
   }
 }
 
-/// The first sample of a wheel gyro after t_from that shows the wheel rolling (0.5 rad/s),
-/// within 900 s, as the manifest draft looks for it.
-std::optional<double> first_rolling(const fs::path& file, double t_from) {
-  ImuReadOptions o;
-  o.gap_factor = std::numeric_limits<double>::infinity();
-  ImuFileReader r(file, o);
-  ImuSample s;
-  while (r.next(s)) {
-    if (s.t < t_from) continue;
-    if (s.t > t_from + 900.0) break;
-    if (r.row().gyro.norm() > 0.5) return s.t;
-  }
-  return std::nullopt;
-}
 
 /// Module kinds by name: "body", "base" or "chassis" -> a Body-IMU, else a Wheel-IMU.
 bool looks_like_body(const std::string& name) {
@@ -401,7 +388,7 @@ ImportResult Importer::run() {
   if (!(man.static_end > man.static_start))
     for (const ModuleSpec& s : man.modules)
       if (s.kind == ModuleKind::kWheel) {
-        if (const auto t = first_rolling(man.resolve(s.file), man.static_start); t && *t - 0.5 - man.static_start >= 1.0) {
+        if (const auto t = motion_from_wheel(man.resolve(s.file), man.static_start); t && *t - 0.5 - man.static_start >= 1.0) {
           man.static_end = *t - 0.5;
           d.notes.comments["static_period_s"] = "until 0.5 s before the first motion (wheel gyro of " + s.name + ")";
           std::erase_if(d.todo, [](const std::string& x) { return x.rfind("static_period_s", 0) == 0; });
