@@ -9,6 +9,14 @@
 
 namespace wheelins {
 
+namespace {
+std::vector<double> configured_weights(const Subsystems& subs) {
+  std::vector<double> w(subs.size());
+  for (int i = 0; i < subs.size(); ++i) w[i] = subs.weight(i);
+  return w;
+}
+}  // namespace
+
 Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& modules,
                      const NavigatorOptions& options, Sink sink)
     : opt_(options),
@@ -21,7 +29,8 @@ Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& 
       filter_(make_filter_backend(subs_, options.fusion.centralized)),
       output_(subs_, *filter_, frame_, opt_, std::move(sink)),
       faults_(make_fault_handler(opt_.faults, subs_, *filter_, output_)),
-      noise_(opt_.noise, subs_, opt_.wheel.velocity_update_interval) {
+      noise_(opt_.noise, subs_, opt_.wheel.velocity_update_interval),
+      weights_(opt_.fusion, configured_weights(subs_)) {
   opt_.validate();
   static_.resize(subs_.size());
 }
@@ -196,8 +205,10 @@ void Navigator::position_step() {
   // reference; modules on probation are tied to it without moving it.
   SharedInputs& sh = shared_;
   int n_ref = 0, n_tied = 0;
+  if (weights_.from_covariance()) update_weights();
   const bool have_ref = reference_weights(sh.k, n_ref, n_tied);
   faults_->on_position_step(min_time());
+  if (have_ref) weights_.record(min_time(), sh.k);
   if (!have_ref || n_tied < 2) return;
   auto record = [&](const UpdateReport& rep) {
     ++stats_.position_updates;
@@ -220,6 +231,18 @@ void Navigator::position_step() {
     noise_.after_position(i, rep);
     record(rep);
   }
+}
+
+void Navigator::update_weights() {
+  SharedInputs& sh = shared_;
+  take_reference(sh, false);  // every o and its H_mlt at the current state
+  Mat21 scratch;
+  for (int i = 0; i < subs_.size(); ++i) {
+    const bool counted = faults_->counted(i);
+    weights_.observe(i, counted ? reference_point_variance(sh.ref[i], filter_->covariance(i, scratch)) : 0.0,
+                     counted);
+  }
+  subs_.set_weights(weights_.weights());
 }
 
 bool Navigator::reference_weights(std::array<double, kMaxModules>& k, int& n_ref,

@@ -30,6 +30,7 @@
 #include "wheelins/fusion/noise_adaptation.hpp"
 #include "wheelins/fusion/options.hpp"
 #include "wheelins/fusion/output.hpp"
+#include "wheelins/fusion/reference_weights.hpp"
 #include "wheelins/fusion/subsystems.hpp"
 #include "wheelins/nav/trajectory_record.hpp"
 #include "wheelins/nav/vehicle.hpp"
@@ -78,6 +79,8 @@ class Navigator {
   /// What the noise identification found for subsystem i, with the consistency figures and
   /// the warnings (noise_adaptation.hpp).
   ModuleNoiseReport noise_report(int i) const { return noise_.report(i); }
+  /// The reference weights of eq. (8) at every constraint epoch (reference_weights.hpp).
+  const std::vector<WeightRecord>& weight_history() const { return weights_.history(); }
 
  private:
   using Use = std::array<bool, kMaxModules>;
@@ -101,6 +104,9 @@ class Navigator {
   /// The reference weights k (eq. 8) renormalised over the counted modules (0 for the
   /// others); false when no module counts.
   bool reference_weights(std::array<double, kMaxModules>& k, int& n_ref, int& n_tied) const;
+  /// ReferenceWeighting::kCovariance: every subsystem's o variance into the weights, which
+  /// become the subsystems' k_i (Subsystems::set_weights) for this epoch on.
+  void update_weights();
   void count_velocity_update(int i, const UpdateReport& rep, double t);
   /// Covariance health of every subsystem in use (Cholesky test, asymmetry).
   void check_covariances();
@@ -121,6 +127,7 @@ class Navigator {
   OutputFusion output_;
   std::unique_ptr<FaultHandler> faults_;
   NoiseAdaptation noise_;
+  ReferenceWeights weights_;
   std::vector<StaticAccumulator> static_;
   SharedInputs shared_;    ///< scratch of the update steps (no allocation per epoch)
   Measurement meas_;       ///< scratch of the update steps

@@ -18,6 +18,12 @@ std::string NavigatorOptions::describe() const {
     << "Body-INS velocity sigma:    " << body.velocity_std.transpose() << " m/s\n"
     << "position constraint:        " << onoff(fusion.position_constraint) << ", every "
     << fusion.position_update_interval << " s, sigma " << fusion.position_std << " m\n"
+    << "reference weights (eq. 8):  "
+    << (fusion.weighting == ReferenceWeighting::kCovariance
+            ? "inverse variance of each subsystem's o, averaged over " +
+                  std::to_string(static_cast<int>(fusion.weight_window)) + " constraint epochs"
+            : std::string(fusion.weights.empty() ? "equal (paper)" : "fixed, as configured"))
+    << "\n"
     << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
     << "filter structure:           "
     << (fusion.centralized ? "centralized (one joint covariance)" : "distributed (paper)") << "\n"
@@ -85,6 +91,10 @@ void NavigatorOptions::validate() const {
     fail("position update interval: must be > 0 s", fusion.position_update_interval);
   if (!(fusion.position_std > 0.0) || !std::isfinite(fusion.position_std))
     fail("position constraint sigma: must be > 0 m", fusion.position_std);
+  if (!(fusion.weight_window >= 1.0 && fusion.weight_window <= 1e6))
+    fail("reference weight window: must be in [1, 1e6] constraint epochs", fusion.weight_window);
+  if (fusion.weighting == ReferenceWeighting::kCovariance && !fusion.weights.empty())
+    throw InputError("fusion weights: fixed weights and weights from the covariance exclude each other");
   noise.validate();
 }
 

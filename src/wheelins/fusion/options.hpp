@@ -21,6 +21,12 @@ enum class SpeedSharing {
   kOwn,   ///< each Wheel-INS its own wheel's speed; a Body-INS the mean, at the mean wheel point
 };
 
+/// Where the reference weights k_i of eq. (8) come from.
+enum class ReferenceWeighting {
+  kFixed,       ///< FusionOptions::weights (empty: equal), the paper
+  kCovariance,  ///< each subsystem's own uncertainty of o: inverse variance (reference_weights.hpp)
+};
+
 struct FusionOptions {
   SpeedSharing speed = SpeedSharing::kMean;
   bool share_level = true;                ///< Body-INS roll/pitch to the Wheel-INSs
@@ -29,6 +35,9 @@ struct FusionOptions {
   double position_std = 0.2;              ///< [m] (Table 9)
   double position_gate = 0.0;             ///< test-ratio gate; 0 = off
   std::vector<double> weights;            ///< k_i of eq. (8); empty = equal
+  ReferenceWeighting weighting = ReferenceWeighting::kFixed;
+  /// kCovariance: constraint epochs the variances are averaged over (e-folding).
+  double weight_window = 60.0;
   /// One joint covariance over all IMUs (Section VI-B-2) instead of one per subsystem.
   bool centralized = false;
 };

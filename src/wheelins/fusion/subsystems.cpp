@@ -61,4 +61,10 @@ Subsystems::Subsystems(const VehicleSetup& setup, const std::vector<std::string>
   for (int i = 0; i < size(); ++i) wheel_[i] = wheels[i];
 }
 
+void Subsystems::set_weights(const std::array<double, kMaxModules>& k) {
+  double sum = 0.0;
+  for (int i = 0; i < size(); ++i) sum += k[i];
+  for (int i = 0; i < size(); ++i) weights_[i] = k[i] / sum;
+}
+
 }  // namespace wheelins

@@ -38,6 +38,8 @@ class Subsystems {
 
   /// k_i of eq. (8), normalised to a sum of 1 over all subsystems.
   double weight(int i) const { return weights_[i]; }
+  /// Replaces the weights (each > 0, normalised here to a sum of 1).
+  void set_weights(const std::array<double, kMaxModules>& k);
   /// Where subsystem i's samples come from (e.g. its file).
   const std::string& source(int i) const { return sources_[i]; }
 

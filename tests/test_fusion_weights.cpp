@@ -1,0 +1,123 @@
+// The reference weights of eq. (8) from each subsystem's own uncertainty
+// (fusion/reference_weights.hpp): the variance of a subsystem's reference point, the
+// averaged inverse-variance weights, a module leaving and rejoining the mean, the
+// record over time (weights.csv) and the run configuration's keys. The end-to-end case
+// (a poor chip counts less) is FusionFaults.APoorChipCountsLessWithWeightsFromTheCovariance.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "io_test_util.hpp"
+#include "wheelins/fusion/reference_weights.hpp"
+#include "wheelins/run/run_config.hpp"
+
+using namespace wheelins;
+namespace fs = std::filesystem;
+
+namespace {
+
+FusionOptions covariance_weighting(double window = 60.0) {
+  FusionOptions o;
+  o.weighting = ReferenceWeighting::kCovariance;
+  o.weight_window = window;
+  return o;
+}
+
+}  // namespace
+
+TEST(ReferenceWeights, VarianceOfTheReferencePointIsItsHorizontalTrace) {
+  // o = r_b + a heading lever: H has I in the position block and a column in phi_z.
+  ReferencePointModel r;
+  r.H.block<3, 3>(0, P).setIdentity();
+  r.H(0, PHI + 2) = -0.5;
+  r.H(1, PHI + 2) = 1.5;
+  Mat21 cov = Mat21::Zero();
+  cov.block<3, 3>(P, P) = Vec3(1.0, 4.0, 9.0).asDiagonal();
+  cov(PHI + 2, PHI + 2) = 0.01;
+  cov(P, PHI + 2) = cov(PHI + 2, P) = 0.02;
+  // tr of the top 2x2 of H P H^T: (1 + 0.25 * 0.01 - 2 * 0.5 * 0.02) + (4 + 2.25 * 0.01)
+  const double expected = 1.0 + 0.0025 - 0.02 + 4.0 + 0.0225;
+  EXPECT_NEAR(reference_point_variance(r, cov), expected, 1e-12);
+  const Mat3 full = r.H * cov * r.H.transpose();
+  EXPECT_NEAR(reference_point_variance(r, cov), full(0, 0) + full(1, 1), 1e-12);
+}
+
+TEST(ReferenceWeights, InverseVarianceAveragedOverTheWindow) {
+  ReferenceWeights w(covariance_weighting(10.0), {0.5, 0.5});
+  ASSERT_TRUE(w.from_covariance());
+  w.observe(0, 1.0, true);
+  w.observe(1, 4.0, true);
+  EXPECT_DOUBLE_EQ(w.weight(0), 1.0);
+  EXPECT_DOUBLE_EQ(w.weight(1), 0.25);
+  // The next epoch moves the average by a tenth of the change, not all of it.
+  w.observe(0, 2.0, true);
+  EXPECT_DOUBLE_EQ(w.weight(0), 1.0 / 1.1);
+  // A variance of zero is floored: no subsystem's o is exact.
+  ReferenceWeights z(covariance_weighting(), {0.5, 0.5});
+  z.observe(0, 0.0, true);
+  EXPECT_DOUBLE_EQ(z.weight(0), 1.0 / ReferenceWeights::kMinVariance);
+}
+
+TEST(ReferenceWeights, AModuleThatRejoinsStartsAfreshFromItsNewCovariance) {
+  ReferenceWeights w(covariance_weighting(10.0), {0.5, 0.5});
+  for (int k = 0; k < 100; ++k) w.observe(0, 1.0, true);
+  w.observe(0, 0.0, false);  // out (fault handling): no average kept
+  w.observe(0, 9.0, true);   // back, restarted with a larger covariance
+  EXPECT_DOUBLE_EQ(w.weight(0), 1.0 / 9.0);
+}
+
+TEST(ReferenceWeights, FixedWeightsAreKeptAndRecorded) {
+  FusionOptions o;
+  ReferenceWeights w(o, {0.25, 0.75});
+  EXPECT_FALSE(w.from_covariance());
+  w.observe(0, 100.0, true);  // ignored
+  EXPECT_DOUBLE_EQ(w.weight(0), 0.25);
+  EXPECT_DOUBLE_EQ(w.weight(1), 0.75);
+  std::array<double, kMaxModules> k{};
+  k[0] = 0.25;
+  k[1] = 0.75;
+  w.record(10.0, k);
+  k[0] = 0.0;  // left out at this epoch
+  k[1] = 1.0;
+  w.record(11.0, k);
+  ASSERT_EQ(w.history().size(), 2u);
+  const std::vector<WeightSummary> s = summarize_weights(w.history(), 2);
+  EXPECT_DOUBLE_EQ(s[0].mean, 0.25);
+  EXPECT_DOUBLE_EQ(s[0].counted, 0.5);
+  EXPECT_DOUBLE_EQ(s[1].min, 0.75);
+  EXPECT_DOUBLE_EQ(s[1].max, 1.0);
+  EXPECT_EQ(weights_csv(w.history(), {"left-C1", "right-C1"}),
+            "t,left-C1,right-C1\n10.000,0.250000,0.750000\n11.000,0.000000,1.000000\n");
+  const std::string text = weights_report(w.history(), {"left-C1", "right-C1"}, o);
+  EXPECT_NE(text.find("equal"), std::string::npos) << text;
+  EXPECT_NE(text.find("left-C1      0.250 [0.250, 0.250]  (counted in 50.0 % of the epochs)"),
+            std::string::npos)
+      << text;
+}
+
+TEST(ReferenceWeights, RunConfigurationChoosesTheWeighting) {
+  const iotest::ScratchDir dir;
+  const fs::path cfg = dir / "w.yaml";
+  iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: covariance, weight_window_epochs: 30}\n");
+  RunConfig c = load_run_config(cfg, {});
+  EXPECT_EQ(c.nav.fusion.weighting, ReferenceWeighting::kCovariance);
+  EXPECT_DOUBLE_EQ(c.nav.fusion.weight_window, 30.0);
+  EXPECT_TRUE(c.nav.fusion.weights.empty());
+  iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: equal}\n");
+  EXPECT_EQ(load_run_config(cfg, {}).nav.fusion.weighting, ReferenceWeighting::kFixed);
+  iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: [1, 2]}\n");
+  c = load_run_config(cfg, {});
+  EXPECT_EQ(c.nav.fusion.weighting, ReferenceWeighting::kFixed);
+  EXPECT_EQ(c.nav.fusion.weights, (std::vector<double>{1, 2}));
+  iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: inverse}\n");
+  EXPECT_HAS(iotest::error_of([&] { load_run_config(cfg, {}); }), "fusion.weights: expected equal or covariance");
+  iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: covariance, weight_window_epochs: 0}\n");
+  EXPECT_HAS(iotest::error_of([&] { load_run_config(cfg, {}); }), "fusion.weight_window_epochs: must be in");
+  EXPECT_THROW(weighting_from_name("x"), InputError);
+  // Fixed weights and weights from the covariance together are refused by the options.
+  NavigatorOptions n;
+  n.fusion.weighting = ReferenceWeighting::kCovariance;
+  n.fusion.weights = {1.0, 1.0};
+  EXPECT_THROW(n.validate(), InputError);
+}
