@@ -34,6 +34,7 @@ struct RunArgs {
   std::string out;
   std::string formats;
   std::string speed;
+  std::string weights;
   bool centralized = false;
   bool no_constraint = false;
   bool no_faults = false;
@@ -87,6 +88,10 @@ int run(const RunArgs& a) {
     for (const auto& f : split_list(a.formats)) cfg.formats.push_back(trajectory_format_from_name(f));
   }
   if (!a.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(a.speed);
+  if (!a.weights.empty()) {
+    cfg.nav.fusion.weighting = weighting_from_name(a.weights);
+    cfg.nav.fusion.weights.clear();  // the command line overrides the configuration's list
+  }
   if (a.centralized) cfg.nav.fusion.centralized = true;
   if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
   if (a.force) cfg.overwrite = true;
@@ -136,6 +141,7 @@ int run(const RunArgs& a) {
               static_cast<unsigned long long>(st.covariance_not_pd), st.max_covariance_asymmetry);
   if (req.nav.faults.enabled) std::cout << res.fault_report;
   std::cout << res.noise_report;
+  std::cout << res.weights_report;
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
 
   if (evaluate) {
@@ -186,6 +192,9 @@ const bool registered = cli::register_command(
       sub.add_option("--out,-o", a->out, "Output directory");
       sub.add_option("--formats", a->formats, "Trajectory formats: csv,tum,kml (default: all)");
       sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
+      sub.add_option("--weights", a->weights,
+                     "Reference weights k_i of eq. (8): equal (paper) | covariance (each "
+                     "subsystem's own uncertainty; weights.csv)");
       sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
       sub.add_flag("--no-evaluate", a->no_evaluate,

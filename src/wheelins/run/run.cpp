@@ -31,6 +31,10 @@ const char* extension(TrajectoryFormat f) {
   }
 }
 bool multi(const RunRequest& r) { return r.modules.size() > 1 && r.write_subsystems; }
+/// weights.csv: a run of several modules with the position constraint.
+bool writes_weights(const RunRequest& r) {
+  return r.modules.size() > 1 && r.nav.fusion.position_constraint;
+}
 
 using io_detail::format_double;
 using io_detail::quote;
@@ -124,6 +128,7 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
     for (const auto& m : r.modules) files.push_back(r.output_dir / (m + ".csv"));
   files.push_back(r.output_dir / "faults.csv");
   files.push_back(r.output_dir / "noise.yaml");
+  if (writes_weights(r)) files.push_back(r.output_dir / "weights.csv");
   return files;
 }
 
@@ -294,8 +299,15 @@ RunResult run_navigation(const RunRequest& r) {
     AtomicTextFile noise(staged(r.output_dir / "noise.yaml"), false);
     noise.write(noise_report_yaml(result.noise, r.manifest, r.nav.noise.enabled));
     noise.commit();
+    if (writes_weights(r)) {
+      AtomicTextFile weights(staged(r.output_dir / "weights.csv"), false);
+      weights.write(weights_csv(nav.weight_history(), r.modules));
+      weights.commit();
+    }
     out_dir->commit();  // every file appears at once
   }
+  result.weights = nav.weight_history();
+  result.weights_report = weights_report(result.weights, r.modules, r.nav.fusion);
   result.fault_report = fault_report_text(nav.faults());
   if (!input_faults.empty()) {
     if (result.fault_report.rfind("faults: none detected", 0) == 0) result.fault_report = "faults:\n" + result.fault_report.substr(22);

@@ -39,6 +39,8 @@ struct RunResult {
   std::vector<FaultEvent> fault_events;      ///< every detection and what was done
   std::vector<ModuleNoiseReport> noise;      ///< the noise model per module (noise.yaml)
   std::string noise_report;                  ///< readable summary of it, with the warnings
+  std::vector<WeightRecord> weights;         ///< the reference weights of eq. (8) over time (weights.csv)
+  std::string weights_report;                ///< readable summary of them (multi-IMU runs)
 };
 
 /// Runs the request. The output directory is written through OutputDir: checked, locked

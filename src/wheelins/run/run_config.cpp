@@ -23,6 +23,12 @@ SpeedSharing speed_sharing_from_name(const std::string& name) {
   throw InputError("wheel speed sharing '" + name + "': expected mean or own");
 }
 
+ReferenceWeighting weighting_from_name(const std::string& name) {
+  if (name == "equal") return ReferenceWeighting::kFixed;
+  if (name == "covariance") return ReferenceWeighting::kCovariance;
+  throw InputError("reference weights '" + name + "': expected equal or covariance");
+}
+
 RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   const YamlReader y(file, warn, "run configuration");
   const YAML::Node& root = y.root();
@@ -137,7 +143,8 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   if (auto f = y.get(root, "fusion"); f.IsDefined()) {
     y.require_map(f, "fusion");
     y.check_keys(f, "fusion", {"speed", "share_level", "position_constraint", "position_update_hz",
-                               "position_std_m", "position_gate", "weights", "centralized"});
+                               "position_std_m", "position_gate", "weights", "weight_window_epochs",
+                               "centralized"});
     FusionOptions& o = c.nav.fusion;
     if (auto v = y.get(f, "speed"); v.IsDefined())
       o.speed = y.choice<SpeedSharing>(v, "fusion.speed",
@@ -155,7 +162,12 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     if (auto v = y.get(f, "position_gate"); v.IsDefined()) {
       o.position_gate = y.number_in(v, "fusion.position_gate", 0.0, 1e4, "(test ratio; 0 = off)");
     }
-    if (auto v = y.get(f, "weights"); v.IsDefined()) {
+    if (auto v = y.get(f, "weights"); v.IsDefined() && v.IsScalar()) {
+      // equal (the paper) | covariance (from each subsystem's uncertainty) | a list.
+      o.weighting = y.choice<ReferenceWeighting>(
+          v, "fusion.weights",
+          {{"equal", ReferenceWeighting::kFixed}, {"covariance", ReferenceWeighting::kCovariance}});
+    } else if (v.IsDefined()) {
       o.weights = y.number_list(v, "fusion.weights");
       if (o.weights.empty()) y.fail("fusion.weights", "an empty list (leave it out for equal weights)", &v);
       for (std::size_t i = 0; i < o.weights.size(); ++i)
@@ -166,6 +178,8 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
                      "the configuration instead of giving it weight 0)",
                  &v);
     }
+    if (auto v = y.get(f, "weight_window_epochs"); v.IsDefined())
+      o.weight_window = y.number_in(v, "fusion.weight_window_epochs", 1.0, 1e6, "constraint epochs");
     if (auto v = y.get(f, "centralized"); v.IsDefined()) o.centralized = y.boolean(v, "fusion.centralized");
   }
 

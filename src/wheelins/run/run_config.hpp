@@ -30,6 +30,8 @@ struct RunConfig {
 RunConfig load_run_config(const std::filesystem::path& file, const WarningSink& warn);
 
 SpeedSharing speed_sharing_from_name(const std::string& name);
+/// `equal` (the paper) or `covariance` (reference_weights.hpp); InputError otherwise.
+ReferenceWeighting weighting_from_name(const std::string& name);
 
 /// Loads the manifest, resolves the modules and fills a RunRequest.
 RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn);
