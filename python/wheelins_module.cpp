@@ -61,9 +61,9 @@ py::dict stats_dict(const NavigatorStats& s) {
 
 /// What `wheelins run` takes besides the files, with its option names.
 struct Settings {
-  std::string configuration, config, speed;
+  std::string configuration, config, speed, weights;
   std::vector<std::string> chips, modules, formats;
-  std::optional<bool> centralized, position_constraint, fault_handling;
+  std::optional<bool> centralized, position_constraint, fault_handling, fixed_noise;
   std::optional<double> duration, output_interval, covariance_interval;
 };
 
@@ -90,6 +90,11 @@ RunConfig run_config(const std::string& manifest, const Settings& s) {
     for (const auto& f : s.formats) cfg.formats.push_back(trajectory_format_from_name(f));
   }
   if (!s.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(s.speed);
+  if (!s.weights.empty()) {
+    cfg.nav.fusion.weighting = weighting_from_name(s.weights);
+    cfg.nav.fusion.weights.clear();  // as wheelins run --weights: over the config's list
+  }
+  if (s.fixed_noise) cfg.nav.noise.enabled = !*s.fixed_noise;
   if (s.centralized) cfg.nav.fusion.centralized = *s.centralized;
   if (s.position_constraint) cfg.nav.fusion.position_constraint = *s.position_constraint;
   if (s.fault_handling) cfg.nav.faults.enabled = *s.fault_handling;
@@ -112,7 +117,8 @@ struct RunOutput {
   std::vector<TrajectoryRecord> records;
   std::optional<std::string> metrics_json;
   NavigatorStats stats;
-  std::string fault_report;
+  std::string fault_report, noise_report, weights_report;
+  std::vector<WeightRecord> weights;  ///< the reference weights of eq. (8) over time
   std::vector<std::string> files;
   std::string manifest;
   std::vector<double> origin_deg;  ///< the manifest's origin: lat [deg], lon [deg], h [m]
@@ -124,9 +130,11 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
               const std::vector<std::string>& formats, const std::string& speed, std::optional<bool> centralized,
               std::optional<bool> position_constraint, std::optional<bool> fault_handling, bool evaluate,
               std::optional<double> duration, std::optional<double> output_interval,
-              std::optional<double> covariance_interval, bool force, bool progress) {
-  Settings s{configuration, text(config).value_or(""), speed, chips, modules, formats,
-             centralized, position_constraint, fault_handling, duration, output_interval, covariance_interval};
+              std::optional<double> covariance_interval, const std::string& weights,
+              std::optional<bool> fixed_noise, bool force, bool progress) {
+  Settings s{configuration, text(config).value_or(""), speed, weights, chips, modules, formats,
+             centralized, position_constraint, fault_handling, fixed_noise, duration, output_interval,
+             covariance_interval};
   RunConfig cfg = run_config(text(manifest).value_or(""), s);
   if (force) cfg.overwrite = true;
   const std::optional<std::string> out_dir = text(out);
@@ -159,6 +167,9 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
   }
   o.stats = res.stats;
   o.fault_report = res.fault_report;
+  o.noise_report = res.noise_report;
+  o.weights_report = res.weights_report;
+  o.weights = res.weights;
   for (const auto& f : res.files) o.files.push_back(f.string());
   o.wall_seconds = res.wall_seconds;
   return o;
@@ -271,8 +282,9 @@ class StreamNavigator {
                   std::optional<bool> centralized, std::optional<bool> position_constraint,
                   std::optional<bool> fault_handling, std::optional<double> duration,
                   std::optional<double> output_interval, std::optional<double> covariance_interval) {
-    Settings s{configuration, text(config).value_or(""), speed, chips, modules, {},
-               centralized, position_constraint, fault_handling, duration, output_interval, covariance_interval};
+    Settings s{configuration, text(config).value_or(""), speed, "", chips, modules, {},
+               centralized, position_constraint, fault_handling, std::nullopt, duration, output_interval,
+               covariance_interval};
     req_ = make_run_request(run_config(text(manifest).value_or(""), s), stderr_sink());
     req_.output_dir.clear();
     validate_run_request(req_);
@@ -430,6 +442,20 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("modules", &RunOutput::modules)
       .def_readonly("metrics_json", &RunOutput::metrics_json)
       .def_readonly("fault_report", &RunOutput::fault_report)
+      .def_readonly("noise_report", &RunOutput::noise_report)
+      .def_readonly("weights_report", &RunOutput::weights_report)
+      .def_property_readonly("weights_table",
+                             [](const RunOutput& r) {
+                               // rows: t, then one weight per module (weights.csv's columns)
+                               const std::size_t n = r.modules.size();
+                               py::array_t<double> a({r.weights.size(), n + 1});
+                               auto v = a.mutable_unchecked<2>();
+                               for (std::size_t i = 0; i < r.weights.size(); ++i) {
+                                 v(i, 0) = r.weights[i].t;
+                                 for (std::size_t j = 0; j < n; ++j) v(i, j + 1) = r.weights[i].k[j];
+                               }
+                               return a;
+                             })
       .def_readonly("files", &RunOutput::files)
       .def_readonly("manifest", &RunOutput::manifest)
       .def_readonly("origin_deg", &RunOutput::origin_deg)
@@ -442,7 +468,8 @@ PYBIND11_MODULE(_core, m) {
         py::arg("formats") = std::vector<std::string>{}, py::arg("speed") = "", py::arg("centralized") = py::none(),
         py::arg("position_constraint") = py::none(), py::arg("fault_handling") = py::none(), py::arg("evaluate") = true,
         py::arg("duration") = py::none(), py::arg("output_interval") = py::none(),
-        py::arg("covariance_interval") = py::none(), py::arg("force") = false, py::arg("progress") = false);
+        py::arg("covariance_interval") = py::none(), py::arg("weights") = "", py::arg("fixed_noise") = py::none(),
+        py::arg("force") = false, py::arg("progress") = false);
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
         py::arg("origin") = py::none(), py::arg("series") = false);

@@ -114,6 +114,27 @@ def test_run_options_and_files(dataset, tmp_path):
         wheelins.run(dataset["manifest"], no_such_setting=1)
 
 
+def test_run_weights_and_fixed_noise_as_the_cli(dataset, tmp_path):
+    r = wheelins.run(dataset["manifest"], "triple", out=tmp_path / "py", formats=["csv"], weights="covariance",
+                     fixed_noise=True, duration=40.0, output_interval=0.1)
+    cli("run", "-m", dataset["manifest"], "-c", "triple", "-o", tmp_path / "cli", "--formats", "csv",
+        "--weights", "covariance", "--fixed-noise", "--duration", 40, "--output-interval", 0.1, "-q")
+    same_as_csv(r.trajectory, read_csv(tmp_path / "cli" / "trajectory.csv"))
+    theirs = read_csv(tmp_path / "cli" / "weights.csv")
+    assert list(r.weights) == ["t_s"] + r.modules
+    assert len(r.weights["t_s"]) == len(theirs["t"]) > 20
+    for m in r.modules:
+        assert r.weights[m] == pytest.approx(theirs[m], abs=1e-6), m
+    total = sum(r.weights[m] for m in r.modules)
+    assert total == pytest.approx(np.ones_like(total), abs=1e-9)
+    assert "inverse variance" in r.weights_report
+    assert "(the given figures, held fixed)" in r.noise_report
+    single = wheelins.run(dataset["manifest"], "single", duration=5.0)
+    assert single.weights == {}
+    with pytest.raises(ValueError, match="expected equal or covariance"):
+        wheelins.run(dataset["manifest"], "triple", weights="inverse", duration=5.0)
+
+
 def load_rows(dataset, module_file):
     return np.fromfile(os.path.join(os.path.dirname(dataset["manifest"]), module_file), dtype="<f8").reshape(-1, 7)
 

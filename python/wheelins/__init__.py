@@ -76,6 +76,9 @@ class Result:
     """A run: .trajectory (dict of numpy arrays keyed by the trajectory CSV's header names,
     in its units), .metrics (the evaluation against the manifest's truth, keyed as
     `wheelins evaluate --json`; None without a truth file), .stats, .fault_report,
+    .noise_report (the noise model identified, as printed by `wheelins run`), .weights (the
+    reference weights of eq. (8) at every constraint epoch, as weights.csv: dict of numpy
+    arrays, "t_s" and one per module; empty for a single IMU), .weights_report,
     .modules, .files (written when run(out=...))."""
 
     def __init__(self, output):
@@ -84,6 +87,11 @@ class Result:
         self.metrics = None if output.metrics_json is None else _json.loads(output.metrics_json)
         self.stats = output.stats
         self.fault_report = output.fault_report
+        self.noise_report = output.noise_report
+        self.weights_report = output.weights_report
+        w = output.weights_table
+        self.weights = {} if w.shape[0] == 0 else {
+            name: _np.ascontiguousarray(w[:, k]) for k, name in enumerate(["t_s"] + list(output.modules))}
         self.modules = list(output.modules)
         self.files = list(output.files)
         self.origin = list(output.origin_deg)  # the trajectory's north/east/down origin
@@ -102,7 +110,8 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
     (docs/run-config.md), which the other arguments override; out: a directory to write
     the trajectory files to (default: none written). filter_settings are the options of
     `wheelins run` by name: speed="own", centralized=True, position_constraint=False,
-    fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0.
+    fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0,
+    weights="covariance" (or "equal"), fixed_noise=True.
     """
     if isinstance(chips, str):
         chips = [c for c in chips.split(",") if c]
