@@ -102,6 +102,10 @@ printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: [1,
 case_ "fusion weights [1, 0, 0] (error: every module needs a positive weight)" trirun "$S/run-w100.yaml"
 printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: [0, 0, 0]}\noutput: {dir: w000}\n' > "$S/run-w000.yaml"
 case_ "fusion weights [0, 0, 0]" trirun "$S/run-w000.yaml"
+printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: inverse}\noutput: {dir: winv}\n' > "$S/run-winv.yaml"
+case_ "fusion weights: an unknown weighting" trirun "$S/run-winv.yaml"
+printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: covariance, weight_window_epochs: 0}\noutput: {dir: wwin}\n' > "$S/run-wwin.yaml"
+case_ "fusion weight window of 0 epochs" trirun "$S/run-wwin.yaml"
 tri_variant() {  # name, python on the rows of the right Wheel-IMU file
   local d="$S/$1"; rm -rf "$d"; cp -r "$T" "$d"
   python3 - "$d/right-wheel-imu/tri_C1_imu.bin" <<EOF

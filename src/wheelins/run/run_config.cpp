@@ -164,9 +164,12 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     }
     if (auto v = y.get(f, "weights"); v.IsDefined() && v.IsScalar()) {
       // equal (the paper) | covariance (from each subsystem's uncertainty) | a list.
-      o.weighting = y.choice<ReferenceWeighting>(
-          v, "fusion.weights",
-          {{"equal", ReferenceWeighting::kFixed}, {"covariance", ReferenceWeighting::kCovariance}});
+      if (v.Scalar() != "equal" && v.Scalar() != "covariance")
+        y.fail("fusion.weights",
+               "expected equal or covariance (or a list of one positive weight per module), got " +
+                   YamlReader::describe(v),
+               &v);
+      o.weighting = v.Scalar() == "covariance" ? ReferenceWeighting::kCovariance : ReferenceWeighting::kFixed;
     } else if (v.IsDefined()) {
       o.weights = y.number_list(v, "fusion.weights");
       if (o.weights.empty()) y.fail("fusion.weights", "an empty list (leave it out for equal weights)", &v);
