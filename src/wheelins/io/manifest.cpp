@@ -368,27 +368,8 @@ void Loader::noise(const YAML::Node& n, const std::string& path, ModuleSpec& out
 
 // ---------------------------------------------------------------------------- writing
 
-std::string yaml_string(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\x%02x", c);
-          out += buf;
-        } else {
-          out += static_cast<char>(c);
-        }
-    }
-  }
-  return out + "\"";
-}
+// A YAML double-quoted scalar: its escapes include JSON's (\", \\, \n, \t, \r, \u00XX).
+std::string yaml_string(const std::string& s) { return io_detail::json_quote(s); }
 
 class YamlWriter {
  public:
