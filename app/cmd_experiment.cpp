@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 struct Args {
   std::string dataset;
   std::string out;
-  std::string speed = "mean";
+  std::string speed = "own";
   std::string only;
   int jobs = 2;
   double duration = 0.0;
@@ -134,7 +134,7 @@ const bool registered = cli::register_command(
       sub.add_option("--out,-o", a->out, "Output directory (default: DATASET/experiment)");
       sub.add_option("--jobs,-j", a->jobs, "Runs in parallel (default 2)")
           ->check(CLI::Range(1, 64));
-      sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
+      sub.add_option("--speed", a->speed, "Wheel speed sharing: own (default) | mean (paper)");
       sub.add_option("--only", a->only,
                      "Subset: single,dual-wheel,body-wheel,triple,centralized (comma list)");
       sub.add_option("--duration", a->duration, "Seconds of navigation per run (default: all)");

@@ -35,6 +35,7 @@ struct RunArgs {
   std::string formats;
   std::string speed;
   std::string weights;
+  std::string yaw;
   bool centralized = false;
   bool no_constraint = false;
   bool no_faults = false;
@@ -88,6 +89,7 @@ int run(const RunArgs& a) {
     for (const auto& f : split_list(a.formats)) cfg.formats.push_back(trajectory_format_from_name(f));
   }
   if (!a.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(a.speed);
+  if (!a.yaw.empty()) cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(a.yaw);
   if (!a.weights.empty()) {
     cfg.nav.fusion.weighting = weighting_from_name(a.weights);
     cfg.nav.fusion.weights.clear();  // the command line overrides the configuration's list
@@ -191,7 +193,10 @@ const bool registered = cli::register_command(
       sub.add_option("--modules", a->modules, "Explicit module names (instead of a configuration)");
       sub.add_option("--out,-o", a->out, "Output directory");
       sub.add_option("--formats", a->formats, "Trajectory formats: csv,tum,kml (default: all)");
-      sub.add_option("--speed", a->speed, "Wheel speed sharing: mean (paper) | own");
+      sub.add_option("--speed", a->speed, "Wheel speed sharing: own (default) | mean (paper)");
+      sub.add_option("--yaw-scale-factors", a->yaw,
+                     "Yaw-rate scale factors: auto (default: from the position constraint with a "
+                     "Body-IMU, distributed filter; else held) | held | constraint | estimated");
       sub.add_option("--weights", a->weights,
                      "Reference weights k_i of eq. (8): equal (paper) | covariance (each "
                      "subsystem's own uncertainty; weights.csv)");

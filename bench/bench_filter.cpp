@@ -109,7 +109,7 @@ void BM_CentralizedUpdateTriple(benchmark::State& state) {
   const Vec3 dz(0.01, -0.02, 0.005);
   std::array<Vec21, kMaxCentralized> dx;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(joint->update(blocks, dz, R, 0.0, dx));
+    benchmark::DoNotOptimize(joint->update(blocks, dz, R, 0.0, dx, nullptr));
     benchmark::ClobberMemory();
   }
 }

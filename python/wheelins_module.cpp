@@ -65,6 +65,7 @@ struct Settings {
   std::vector<std::string> chips, modules, formats;
   std::optional<bool> centralized, position_constraint, fault_handling, fixed_noise;
   std::optional<double> duration, output_interval, covariance_interval;
+  std::string yaw_scale_factors;
 };
 
 /// The run configuration as `wheelins run` builds it from a config file and its flags.
@@ -90,6 +91,8 @@ RunConfig run_config(const std::string& manifest, const Settings& s) {
     for (const auto& f : s.formats) cfg.formats.push_back(trajectory_format_from_name(f));
   }
   if (!s.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(s.speed);
+  if (!s.yaw_scale_factors.empty())
+    cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(s.yaw_scale_factors);
   if (!s.weights.empty()) {
     cfg.nav.fusion.weighting = weighting_from_name(s.weights);
     cfg.nav.fusion.weights.clear();  // as wheelins run --weights: over the config's list
@@ -131,10 +134,11 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
               std::optional<bool> position_constraint, std::optional<bool> fault_handling, bool evaluate,
               std::optional<double> duration, std::optional<double> output_interval,
               std::optional<double> covariance_interval, const std::string& weights,
-              std::optional<bool> fixed_noise, bool force, bool progress) {
+              std::optional<bool> fixed_noise, const std::string& yaw_scale_factors, bool force,
+              bool progress) {
   Settings s{configuration, text(config).value_or(""), speed, weights, chips, modules, formats,
              centralized, position_constraint, fault_handling, fixed_noise, duration, output_interval,
-             covariance_interval};
+             covariance_interval, yaw_scale_factors};
   RunConfig cfg = run_config(text(manifest).value_or(""), s);
   if (force) cfg.overwrite = true;
   const std::optional<std::string> out_dir = text(out);
@@ -281,10 +285,11 @@ class StreamNavigator {
                   const std::vector<std::string>& modules, const py::object& config, const std::string& speed,
                   std::optional<bool> centralized, std::optional<bool> position_constraint,
                   std::optional<bool> fault_handling, std::optional<double> duration,
-                  std::optional<double> output_interval, std::optional<double> covariance_interval) {
+                  std::optional<double> output_interval, std::optional<double> covariance_interval,
+                  const std::string& yaw_scale_factors) {
     Settings s{configuration, text(config).value_or(""), speed, "", chips, modules, {},
                centralized, position_constraint, fault_handling, std::nullopt, duration, output_interval,
-               covariance_interval};
+               covariance_interval, yaw_scale_factors};
     req_ = make_run_request(run_config(text(manifest).value_or(""), s), stderr_sink());
     req_.output_dir.clear();
     validate_run_request(req_);
@@ -469,7 +474,7 @@ PYBIND11_MODULE(_core, m) {
         py::arg("position_constraint") = py::none(), py::arg("fault_handling") = py::none(), py::arg("evaluate") = true,
         py::arg("duration") = py::none(), py::arg("output_interval") = py::none(),
         py::arg("covariance_interval") = py::none(), py::arg("weights") = "", py::arg("fixed_noise") = py::none(),
-        py::arg("force") = false, py::arg("progress") = false);
+        py::arg("yaw_scale_factors") = "", py::arg("force") = false, py::arg("progress") = false);
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
         py::arg("origin") = py::none(), py::arg("series") = false);
@@ -480,12 +485,13 @@ PYBIND11_MODULE(_core, m) {
   py::class_<StreamNavigator>(m, "Navigator")
       .def(py::init<const py::object&, const std::string&, const std::vector<std::string>&, const std::vector<std::string>&,
                     const py::object&, const std::string&, std::optional<bool>, std::optional<bool>, std::optional<bool>,
-                    std::optional<double>, std::optional<double>, std::optional<double>>(),
+                    std::optional<double>, std::optional<double>, std::optional<double>, const std::string&>(),
            py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
            py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("speed") = "",
            py::arg("centralized") = py::none(), py::arg("position_constraint") = py::none(),
            py::arg("fault_handling") = py::none(), py::arg("duration") = py::none(),
-           py::arg("output_interval") = py::none(), py::arg("covariance_interval") = py::none())
+           py::arg("output_interval") = py::none(), py::arg("covariance_interval") = py::none(),
+           py::arg("yaw_scale_factors") = "")
       .def("push", &StreamNavigator::push, py::arg("module"), py::arg("t"), py::arg("gyro"), py::arg("accel"))
       .def("finish", &StreamNavigator::finish)
       .def("covariance", &StreamNavigator::covariance, py::arg("module") = 0)

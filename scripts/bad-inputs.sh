@@ -106,6 +106,9 @@ printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: inv
 case_ "fusion weights: an unknown weighting" trirun "$S/run-winv.yaml"
 printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfusion: {weights: covariance, weight_window_epochs: 0}\noutput: {dir: wwin}\n' > "$S/run-wwin.yaml"
 case_ "fusion weight window of 0 epochs" trirun "$S/run-wwin.yaml"
+printf 'dataset: tri/manifest.yaml\nconfiguration: triple\nfilter: {yaw_scale_factors: held, estimate_yaw_scale_factors: true}\noutput: {dir: wyaw}\n' > "$S/run-wyaw.yaml"
+case_ "yaw scale factors given by both keys" trirun "$S/run-wyaw.yaml"
+case_ "run --yaw-scale-factors sometimes" trirun -m "$S/tri/manifest.yaml" -c triple --yaw-scale-factors sometimes -o "$S/wyaw2"
 tri_variant() {  # name, python on the rows of the right Wheel-IMU file
   local d="$S/$1"; rm -rf "$d"; cp -r "$T" "$d"
   python3 - "$d/right-wheel-imu/tri_C1_imu.bin" <<EOF

@@ -67,6 +67,62 @@ TEST(FilterCovariance, MultipliedOutJosephEqualsTextbookForm) {
   EXPECT_EQ((P - P.transpose()).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(FilterCovariance, ConsiderStatesOfAnUpdateKeepTheirEstimateAndCovariance) {
+  // A gain mask (ProcessNoise::velocity_gain) makes states Schmidt "consider" states of one
+  // update: their rows of K are zero, so their estimate and their own covariance block do
+  // not move, the other states' gains are the optimal ones (they see the consider states'
+  // covariance), and P is the Joseph covariance of that suboptimal K. Also for the stacked
+  // states of the centralized filter.
+  const Mat21 P0 = random_covariance(3);
+  const Eigen::Matrix<double, 3, kStateDim> H = Eigen::Matrix<double, 3, kStateDim>::Random();
+  const Vec3 dz(0.03, -0.01, 0.02);
+  const Mat3 R = Vec3(0.02, 0.03, 0.01).cwiseAbs2().asDiagonal();
+  Vec21 mask = Vec21::Ones();
+  mask(PHI + 2) = mask(SG + 1) = mask(SG + 2) = 0.0;
+  Mat21 P = P0;
+  Vec21 dx = Vec21::Zero();
+  ASSERT_TRUE((ekf_update<3, kStateDim>(P, dx, H, dz, R, 0.0, nullptr, &mask).accepted));
+  const Mat3 S = H * P0 * H.transpose() + R;
+  const Eigen::Matrix<double, kStateDim, 3> K_opt = P0 * H.transpose() * S.inverse();
+  const Eigen::Matrix<double, kStateDim, 3> K = mask.asDiagonal() * K_opt;
+  const Mat21 IKH = Mat21::Identity() - K * H;
+  const Mat21 joseph = IKH * P0 * IKH.transpose() + K * R * K.transpose();
+  EXPECT_LT(rel_diff(P, joseph), 1e-12);
+  EXPECT_LT((dx - K * dz).norm(), 1e-12 * (K * dz).norm());
+  for (int k : {PHI + 2, SG + 1, SG + 2}) {
+    EXPECT_EQ(dx(k), 0.0);
+    EXPECT_NEAR(P(k, k), P0(k, k), 1e-15 * P0(k, k));
+  }
+  EXPECT_NE(dx(V), 0.0);
+  // The masked update is no better than the optimal one (trace), and the same where nothing
+  // is masked.
+  Mat21 P_opt = P0;
+  Vec21 dx_opt = Vec21::Zero();
+  ekf_update<3>(P_opt, dx_opt, H, dz, R);
+  EXPECT_GE(P.trace(), P_opt.trace());
+  Mat21 P_all = P0;
+  Vec21 dx_all = Vec21::Zero();
+  const Vec21 ones = Vec21::Ones();
+  ekf_update<3, kStateDim>(P_all, dx_all, H, dz, R, 0.0, nullptr, &ones);
+  EXPECT_LT(rel_diff(P_all, P_opt), 1e-14);
+
+  using Mat63 = Eigen::Matrix<double, 63, 63>;
+  using Vec63 = Eigen::Matrix<double, 63, 1>;
+  Mat63 A = Mat63::Random();
+  const Mat63 Q0 = A * A.transpose() * 1e-3 + Mat63::Identity() * 1e-4;
+  const Eigen::Matrix<double, 3, 63> Hb = Eigen::Matrix<double, 3, 63>::Random();
+  Vec63 mb = Vec63::Ones();
+  mb(SG + 1) = mb(kStateDim + SG + 2) = mb(2 * kStateDim + SG + 2) = 0.0;
+  Mat63 Q = Q0;
+  Vec63 db = Vec63::Zero();
+  ASSERT_TRUE((ekf_update<3, 63>(Q, db, Hb, dz, R, 0.0, nullptr, &mb).accepted));
+  const Eigen::Matrix<double, 63, 3> Kb = mb.asDiagonal() * (Q0 * Hb.transpose() * (Hb * Q0 * Hb.transpose() + R).inverse());
+  const Mat63 IKHb = Mat63::Identity() - Kb * Hb;
+  const Mat63 jb = IKHb * Q0 * IKHb.transpose() + Kb * R * Kb.transpose();
+  EXPECT_LT((Q - jb).cwiseAbs().maxCoeff(), 1e-12 * jb.cwiseAbs().maxCoeff());
+  EXPECT_EQ(db(kStateDim + SG + 2), 0.0);
+}
+
 TEST(FilterCovariance, StackedStateUpdateEqualsTextbookJoseph) {
   // The centralized filter's update over 3 x 21 stacked states (ekf_update<3, 63>, which
   // updates the lower triangle and mirrors it) against the textbook Joseph form.

@@ -122,6 +122,61 @@ TEST(FusionRunConfig, BadValuesNameTheKeyAndLine) {
   EXPECT_NE(e.find("missing.yaml': run configuration file not found"), std::string::npos) << e;
 }
 
+TEST(FusionRunConfig, YawScaleFactorsAndTheOlderKey) {
+  ScratchDir dir;
+  auto load = [&](const std::string& text) {
+    write_text(dir / "run.yaml", text);
+    return load_run_config(dir / "run.yaml", {});
+  };
+  EXPECT_EQ(load("dataset: m.yaml\n").nav.yaw_scale_factors, YawScaleFactorChoice::kAuto);
+  EXPECT_EQ(load("dataset: m.yaml\n").nav.fusion.speed, SpeedSharing::kOwn);
+  EXPECT_EQ(load("dataset: m.yaml\nfilter: {yaw_scale_factors: constraint}\n").nav.yaw_scale_factors,
+            YawScaleFactorChoice::kFromConstraint);
+  EXPECT_EQ(load("dataset: m.yaml\nfilter: {yaw_scale_factors: held}\n").nav.yaw_scale_factors,
+            YawScaleFactorChoice::kHeld);
+  EXPECT_EQ(load("dataset: m.yaml\nfilter: {estimate_yaw_scale_factors: true}\n").nav.yaw_scale_factors,
+            YawScaleFactorChoice::kEstimated);
+  EXPECT_EQ(load("dataset: m.yaml\nfilter: {estimate_yaw_scale_factors: false}\n").nav.yaw_scale_factors,
+            YawScaleFactorChoice::kHeld);
+  std::string e = error_of([&] { load("dataset: m.yaml\nfilter: {yaw_scale_factors: sometimes}\n"); });
+  EXPECT_NE(e.find("filter.yaw_scale_factors: expected auto or held or constraint or estimated, got 'sometimes'"),
+            std::string::npos) << e;
+  e = error_of([&] {
+    load("dataset: m.yaml\nfilter:\n  yaw_scale_factors: held\n  estimate_yaw_scale_factors: true\n");
+  });
+  EXPECT_NE(e.find("filter.estimate_yaw_scale_factors: conflicts with filter.yaw_scale_factors"), std::string::npos) << e;
+  EXPECT_EQ(yaw_scale_factors_from_name("estimated"), YawScaleFactorChoice::kEstimated);
+  EXPECT_NE(error_of([] { yaw_scale_factors_from_name("x"); }).find("expected auto, held, constraint or estimated"),
+            std::string::npos);
+}
+
+TEST(FusionNavigator, YawScaleFactorsResolvedByConfiguration) {
+  // auto: from the constraint in the distributed filter when a Body-IMU and another module
+  // are in it; held otherwise; an explicit choice is taken as given.
+  NavigatorOptions o;
+  auto mode = [](const NavigatorOptions& r) {
+    EXPECT_EQ(r.wheel.yaw_scale_factors, r.body.yaw_scale_factors);
+    return r.wheel.yaw_scale_factors;
+  };
+  EXPECT_EQ(mode(o.resolved(3, true)), YawScaleFactors::kFromConstraint);
+  EXPECT_EQ(mode(o.resolved(2, true)), YawScaleFactors::kFromConstraint);
+  EXPECT_EQ(mode(o.resolved(2, false)), YawScaleFactors::kHeld);
+  EXPECT_EQ(mode(o.resolved(1, false)), YawScaleFactors::kHeld);
+  NavigatorOptions c = o;
+  c.fusion.centralized = true;
+  EXPECT_EQ(mode(c.resolved(3, true)), YawScaleFactors::kHeld);
+  NavigatorOptions n = o;
+  n.fusion.position_constraint = false;
+  EXPECT_EQ(mode(n.resolved(3, true)), YawScaleFactors::kHeld);
+  NavigatorOptions e = c;
+  e.yaw_scale_factors = YawScaleFactorChoice::kFromConstraint;
+  EXPECT_EQ(mode(e.resolved(3, true)), YawScaleFactors::kFromConstraint);
+  e.yaw_scale_factors = YawScaleFactorChoice::kEstimated;
+  EXPECT_EQ(mode(e.resolved(1, false)), YawScaleFactors::kEstimated);
+  e.yaw_scale_factors = YawScaleFactorChoice::kHeld;
+  EXPECT_EQ(mode(e.resolved(3, true)), YawScaleFactors::kHeld);
+}
+
 TEST(FusionRunConfig, UnknownKeyWarnsWithClosestKnown) {
   ScratchDir dir;
   write_text(dir / "run.yaml", "dataset: m.yaml\nfusion:\n  centralised: true\n");

@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -184,47 +185,77 @@ TEST_F(NoiseAdaptationEndToEnd, IdentifiesTheNoiseTheManifestDoesNotState) {
   }
 }
 
-TEST_F(NoiseAdaptationEndToEnd, YawRateScaleFactorsAreHeldInBothFilters) {
+TEST_F(NoiseAdaptationEndToEnd, YawRateScaleFactorsByConfiguration) {
   // A Wheel-IMU's y and z gyro scale factors and the Body-IMU's along the vehicle's yaw axis
-  // are not estimated (no heading reference), nor the Wheel-IMU's axle accelerometer's: their estimates stay exactly 0 and their rows
-  // of P are 0, in the distributed and the centralized filter; the option brings them back.
+  // (the yaw-rate scale factors) and the Wheel-IMU's axle accelerometer's are not estimated
+  // where nothing shows them: single Wheel-INS, and the centralized filter. Their estimates
+  // stay exactly 0 and their rows of P are 0. In the distributed filter with a Body-IMU in
+  // the position constraint (auto) the yaw-rate scale factors are estimated, from the
+  // constraint alone: they move, with a covariance, while the axle accelerometer's stays
+  // held. The options override the choice.
   const fs::path file = data_->dir / "manifest-none.yaml";
   const Manifest m = load_manifest(file, {});
-  const auto modules = configuration_modules(m, "triple", {});
-  for (bool centralized : {false, true}) {
-    SCOPED_TRACE(centralized ? "centralized" : "distributed");
+  struct Case {
+    const char* configuration;
+    bool centralized;
+    YawScaleFactorChoice choice;
+    bool from_constraint;  ///< the yaw-rate scale factors estimated from the constraint
+  };
+  for (const Case& c : {Case{"triple", true, YawScaleFactorChoice::kAuto, false},
+                        Case{"single", false, YawScaleFactorChoice::kAuto, false},
+                        Case{"dual-wheel", false, YawScaleFactorChoice::kAuto, false},
+                        Case{"triple", false, YawScaleFactorChoice::kHeld, false},
+                        Case{"triple", false, YawScaleFactorChoice::kAuto, true},
+                        Case{"body-wheel", false, YawScaleFactorChoice::kAuto, true},
+                        Case{"dual-wheel", false, YawScaleFactorChoice::kFromConstraint, true}}) {
+    SCOPED_TRACE(std::string(c.configuration) + (c.centralized ? " centralized" : "") +
+                 (c.choice == YawScaleFactorChoice::kAuto ? " auto" : " explicit"));
+    const auto modules = configuration_modules(m, c.configuration, {});
     NavigatorOptions nav;
-    nav.fusion.centralized = centralized;
+    nav.fusion.centralized = c.centralized;
+    nav.yaw_scale_factors = c.choice;
     nav.earth_rotation = m.earth_rotation;
-    nav.noise.enabled = true;
     Navigator navigator(m, modules, nav, [](int, const TrajectoryRecord&) {});
     test::replay(navigator, m, modules, m.static_end + 200.0);
     for (int k = 0; k < navigator.subsystem_count(); ++k) {
       const Subsystem& sub = navigator.subsystem(k);
       const ModuleNoiseReport rep = navigator.noise_report(k);
-      ASSERT_EQ(rep.held.size(), rep.wheel ? 3u : 1u) << rep.module;
-      for (int state : rep.held) {
-        const ImuErrors& e = sub.ekf().errors();
+      const std::vector<int> yaw = rep.wheel ? std::vector<int>{SG + 1, SG + 2} : std::vector<int>{SG + 2};
+      std::vector<int> held = rep.wheel ? std::vector<int>{SA + 0} : std::vector<int>{};
+      if (!c.from_constraint) held.insert(held.begin(), yaw.begin(), yaw.end());
+      std::sort(held.begin(), held.end());
+      EXPECT_EQ(rep.held, held) << rep.module;
+      const ImuErrors& e = sub.ekf().errors();
+      for (int state : held) {
         EXPECT_EQ(state >= SA ? e.sa(state - SA) : e.sg(state - SG), 0.0) << rep.module << " state " << state;
         EXPECT_EQ(sub.process_noise().estimated(state), 0.0);
-        if (!centralized) {
+        if (!c.centralized) {
           EXPECT_EQ(sub.ekf().covariance().row(state).cwiseAbs().maxCoeff(), 0.0);
           EXPECT_EQ(sub.ekf().covariance().col(state).cwiseAbs().maxCoeff(), 0.0);
         }
       }
+      for (int state : yaw) {
+        EXPECT_EQ(sub.process_noise().velocity_gain(state), c.from_constraint ? 0.0 : 1.0) << rep.module;
+        if (c.from_constraint) {
+          EXPECT_NE(e.sg(state - SG), 0.0) << rep.module << ": moved by the constraint";
+          EXPECT_GT(sub.ekf().covariance()(state, state), 0.0) << rep.module;
+        }
+      }
       if (rep.wheel) {
-        EXPECT_EQ(rep.held, (std::vector<int>{SG + 1, SG + 2, SA + 0})) << rep.module;
-        EXPECT_NE(sub.ekf().errors().sg(0), 0.0) << rep.module << ": the spin axis' is estimated";
+        EXPECT_NE(e.sg(0), 0.0) << rep.module << ": the spin axis' is estimated";
       }
     }
   }
   NavigatorOptions on;
-  on.wheel.estimate_yaw_scale_factor = on.body.estimate_yaw_scale_factor = true;
+  on.yaw_scale_factors = YawScaleFactorChoice::kEstimated;
   on.wheel.estimate_axle_accel_scale_factor = true;
   on.earth_rotation = m.earth_rotation;
+  const auto modules = configuration_modules(m, "triple", {});
   Navigator navigator(m, modules, on, [](int, const TrajectoryRecord&) {});
-  for (int k = 0; k < navigator.subsystem_count(); ++k)
+  for (int k = 0; k < navigator.subsystem_count(); ++k) {
     EXPECT_TRUE(navigator.noise_report(k).held.empty()) << navigator.noise_report(k).module;
+    EXPECT_FALSE(navigator.subsystem(k).process_noise().velocity_consider());
+  }
 }
 
 TEST_F(NoiseAdaptationEndToEnd, RunWritesNoiseYaml) {
@@ -250,9 +281,12 @@ TEST_F(NoiseAdaptationEndToEnd, RunWritesNoiseYaml) {
   EXPECT_NEAR(w["in_motion"]["acc_vrw_m_s_sqrt_h"].as<double>(), res.noise[0].vrw * 60.0, 1e-3 * res.noise[0].vrw * 60.0);
   EXPECT_NEAR(w["used"]["gyro_arw_deg_sqrt_h"].as<double>(), res.noise[0].arw / kDeg * 60.0, 1e-3);
   EXPECT_GT(w["consistency"]["velocity"]["updates"].as<int>(), 1000);
-  EXPECT_EQ(w["not_estimated"].size(), 3u);
+  // Body/Wheel-INS, distributed: the yaw-rate scale factors from the constraint (13.4).
+  EXPECT_EQ(w["not_estimated"].size(), 1u);
+  EXPECT_EQ(w["from_constraint_only"].size(), 2u);
   EXPECT_EQ(y["modules"][1]["kind"].as<std::string>(), "body");
-  EXPECT_EQ(y["modules"][1]["not_estimated"].size(), 1u);
+  EXPECT_EQ(y["modules"][1]["not_estimated"].size(), 0u);
+  EXPECT_EQ(y["modules"][1]["from_constraint_only"].size(), 1u);
   // every figure a manifest line can take back
   for (const char* key : {"gyro_arw_deg_sqrt_h", "acc_vrw_m_s_sqrt_h", "gyro_bias_deg_h"})
     EXPECT_TRUE(std::isfinite(w["used"][key].as<double>())) << key;

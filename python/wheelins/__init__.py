@@ -109,9 +109,10 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
     (or "C1,C4"); modules: explicit module names; config: a run configuration YAML
     (docs/run-config.md), which the other arguments override; out: a directory to write
     the trajectory files to (default: none written). filter_settings are the options of
-    `wheelins run` by name: speed="own", centralized=True, position_constraint=False,
+    `wheelins run` by name: speed="mean", centralized=True, position_constraint=False,
     fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0,
-    weights="covariance" (or "equal"), fixed_noise=True.
+    weights="covariance" (or "equal"), fixed_noise=True, yaw_scale_factors="held" (or "auto",
+    "constraint", "estimated").
     """
     if isinstance(chips, str):
         chips = [c for c in chips.split(",") if c]

@@ -10,12 +10,11 @@ BodyIns::BodyIns(const ImuModule& module, const BodyInsOptions& opt,
                  const MechanizationOptions& mech)
     : Subsystem(module, mech), opt_(opt), C_BtoV_(dcm_from_euler(module.mounting_rpy)) {
   // The scale factor of the gyro axis nearest the vehicle's yaw axis is a yaw-rate scale
-  // factor: unobservable without a heading reference, so held (docs/filter.md 13.4).
-  if (!opt.estimate_yaw_scale_factor) {
-    int axis = 0;
-    C_BtoV_.row(2).cwiseAbs().maxCoeff(&axis);
-    noise_.estimated(SG + axis) = 0.0;
-  }
+  // factor: unobservable without a heading reference, so held or estimated from the
+  // position constraint alone (docs/filter.md 13.4).
+  int axis = 0;
+  C_BtoV_.row(2).cwiseAbs().maxCoeff(&axis);
+  set_yaw_scale_factor_mode(opt.yaw_scale_factors, {SG + axis});
 }
 
 void BodyIns::start(const StaticAccumulator& stat, double vehicle_heading, double t0) {

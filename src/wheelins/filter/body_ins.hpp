@@ -14,9 +14,9 @@ struct BodyInsOptions {
   Vec3 velocity_std = Vec3(0.05, 0.04, 0.04);  ///< forward, lateral, vertical [m/s] (Table 9)
   double gate = 0.0;
   InitialUncertainty init;
-  /// Estimate the scale factor of the gyro axis along the vehicle's yaw axis (a yaw-rate
-  /// scale factor, unobservable without a heading reference: held by default).
-  bool estimate_yaw_scale_factor = false;
+  /// The scale factor of the gyro axis along the vehicle's yaw axis (a yaw-rate scale
+  /// factor, unobservable without a heading reference; docs/filter.md 13.4).
+  YawScaleFactors yaw_scale_factors = YawScaleFactors::kHeld;
 };
 
 class BodyIns final : public Subsystem {

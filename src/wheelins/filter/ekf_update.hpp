@@ -29,12 +29,16 @@ struct UpdateReport {
 /// Fuses one measurement of dimension M into (P, dx) of an N-dimensional error state: a
 /// subsystem's 21 states, or the stacked states of all IMUs (the centralized filter). With
 /// gate > 0, rejects it (P and dx untouched) when test_ratio > gate. Joseph form keeps P
-/// positive. `K_out` (optional) receives the gain of an accepted update.
+/// positive. `K_out` (optional) receives the gain of an accepted update. With `gain_mask`,
+/// the states whose entry is 0 are Schmidt "consider" states of this update: their rows of
+/// K are zeroed (the other states' gains still account for their covariance), and the
+/// Joseph form below keeps P the covariance of that suboptimal gain.
 template <int M, int N>
 UpdateReport ekf_update(Eigen::Matrix<double, N, N>& P, Eigen::Matrix<double, N, 1>& dx,
                         const Eigen::Matrix<double, M, N>& H, const Eigen::Matrix<double, M, 1>& dz,
                         const Eigen::Matrix<double, M, M>& R, double gate = 0.0,
-                        Eigen::Matrix<double, N, M>* K_out = nullptr) {
+                        Eigen::Matrix<double, N, M>* K_out = nullptr,
+                        const Eigen::Matrix<double, N, 1>* gain_mask = nullptr) {
   static_assert(M >= 1 && M <= 6);
   using MatM = Eigen::Matrix<double, M, M>;
   using MatNM = Eigen::Matrix<double, N, M>;
@@ -54,7 +58,8 @@ UpdateReport ekf_update(Eigen::Matrix<double, N, N>& P, Eigen::Matrix<double, N,
   rep.test_ratio = rep.nis / kChi2_999[M];
   if (gate > 0.0 && rep.test_ratio > gate) return rep;
 
-  const MatNM K = llt.solve(PHt.transpose()).transpose();
+  MatNM K = llt.solve(PHt.transpose()).transpose();
+  if (gain_mask) K = gain_mask->asDiagonal() * K;
   if (K_out) *K_out = K;
   dx += K * (dz - H.lazyProduct(dx));
   // Joseph form (I - KH) P (I - KH)^T + K R K^T, multiplied out so that no n x n x n

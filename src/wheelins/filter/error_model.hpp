@@ -17,6 +17,11 @@ struct ProcessNoise : ImuNoise {
   ProcessNoise() = default;
   ProcessNoise(const ImuNoise& n) : ImuNoise(n) {}  // NOLINT(google-explicit-constructor)
   Vec21 estimated = Vec21::Ones();
+  /// The estimated states a velocity update may correct: 0 makes a state a Schmidt
+  /// "consider" state of the velocity updates (its gain row zero, its covariance kept and
+  /// used), so that only the position constraint moves it (YawScaleFactors::kFromConstraint).
+  Vec21 velocity_gain = Vec21::Ones();
+  bool velocity_consider() const { return velocity_gain.minCoeff() == 0.0; }
   bool held(int k) const { return estimated(k) == 0.0; }
 };
 

@@ -69,11 +69,11 @@ class StrapdownEkf {
   template <int M>
   UpdateReport update(const Eigen::Matrix<double, M, kStateDim>& H,
                       const Eigen::Matrix<double, M, 1>& dz, const Eigen::Matrix<double, M, M>& R,
-                      double gate = 0.0) {
+                      double gate = 0.0, const Vec21* gain_mask = nullptr) {
     flush_covariance();
     Vec21 dx = Vec21::Zero();
     Eigen::Matrix<double, kStateDim, M> K;
-    const UpdateReport rep = ekf_update<M>(P_, dx, H, dz, R, gate, &K);
+    const UpdateReport rep = ekf_update<M>(P_, dx, H, dz, R, gate, &K, gain_mask);
     if (rep.accepted) {
       feedback(dx);
       // The held states' effect on the estimated ones, through this update (H S includes

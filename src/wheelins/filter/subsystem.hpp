@@ -3,12 +3,23 @@
 // it implies (heading, reference point) with their measurement models.
 #pragma once
 
+#include <initializer_list>
+
 #include "wheelins/filter/alignment.hpp"
 #include "wheelins/filter/position_constraint.hpp"
 #include "wheelins/filter/strapdown_ekf.hpp"
 #include "wheelins/nav/vehicle.hpp"
 
 namespace wheelins {
+
+/// What a subsystem does with its yaw-rate scale factor (the gyro axes in a Wheel-IMU's
+/// wheel plane, the Body-IMU's axis nearest the vehicle's yaw axis; docs/filter.md 13.4).
+enum class YawScaleFactors {
+  kHeld,            ///< not estimated (zero covariance); its effect is carried as a consider term
+  kFromConstraint,  ///< estimated from the multi-IMU position constraint only: a consider
+                    ///< state of the velocity updates (ProcessNoise::velocity_gain)
+  kEstimated,       ///< estimated from every update
+};
 
 /// The vehicle state a subsystem restarts from after an outage or an isolation
 /// (from the other subsystems, or its own extrapolation when it is alone).
@@ -98,6 +109,15 @@ class Subsystem {
   }
 
  protected:
+  /// Applies `mode` to the error states `yaw_states` (the yaw-rate scale factor's) in the
+  /// noise model: held (not estimated), or a consider state of the velocity updates.
+  void set_yaw_scale_factor_mode(YawScaleFactors mode, std::initializer_list<int> yaw_states) {
+    for (int k : yaw_states) {
+      if (mode == YawScaleFactors::kHeld) noise_.estimated(k) = 0.0;
+      if (mode == YawScaleFactors::kFromConstraint) noise_.velocity_gain(k) = 0.0;
+    }
+  }
+
   ImuModule module_;
   MechanizationOptions mech_;
   ProcessNoise noise_;

@@ -18,9 +18,10 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
   // The gyro axes in the wheel plane see the vehicle's yaw rate in turn as the wheel rolls:
   // their scale factors together are a yaw-rate scale factor, which nothing but a heading
   // reference could show; estimated from the velocity updates they run away with the
-  // innovations' unmodelled errors. Held (docs/filter.md 13.4). The axle's (x) is estimated:
-  // the wheel angle it integrates is checked against gravity at every update.
-  if (!opt.estimate_yaw_scale_factor) noise_.estimated(SG + 1) = noise_.estimated(SG + 2) = 0.0;
+  // innovations' unmodelled errors. Held, or estimated from the position constraint alone
+  // (docs/filter.md 13.4). The axle's (x) is estimated: the wheel angle it integrates is
+  // checked against gravity at every update.
+  set_yaw_scale_factor_mode(opt.yaw_scale_factors, {SG + 1, SG + 2});
   // The accelerometer along the axle sees the lateral specific force only: its scale factor
   // and its bias differ only where the course turns both ways (held as well).
   if (!opt.estimate_axle_accel_scale_factor) noise_.estimated(SA + 0) = 0.0;

@@ -17,10 +17,9 @@ struct WheelInsOptions {
   Vec3 velocity_std = Vec3(0.03, 0.02, 0.02);  ///< forward, lateral, vertical [m/s] (Table 9)
   double gate = 0.0;                           ///< innovation gate on the test ratio; 0 = off
   InitialUncertainty init;
-  /// Estimate the scale factors of the gyro axes in the wheel plane (b y, z): together they
-  /// are the yaw-rate scale factor, unobservable without a heading reference (held by
-  /// default, docs/filter.md 13.4).
-  bool estimate_yaw_scale_factor = false;
+  /// The scale factors of the gyro axes in the wheel plane (b y, z): together they are the
+  /// yaw-rate scale factor, unobservable without a heading reference (docs/filter.md 13.4).
+  YawScaleFactors yaw_scale_factors = YawScaleFactors::kHeld;
   /// Estimate the scale factor of the accelerometer along the axle (b x). It sees only the
   /// lateral specific force (the centripetal acceleration of turns, gravity through roll),
   /// which on a course that turns mostly one way is indistinguishable from its bias: held

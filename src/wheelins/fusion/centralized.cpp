@@ -79,16 +79,19 @@ class FixedJointCovariance final : public JointCovariance {
   }
 
   UpdateReport update(const std::array<const H3*, kMaxCentralized>& H, const Vec3& dz,
-                      const Mat3& R, double gate,
-                      std::array<Vec21, kMaxCentralized>& dx) override {
+                      const Mat3& R, double gate, std::array<Vec21, kMaxCentralized>& dx,
+                      const std::array<const Vec21*, kMaxCentralized>* gain_mask) override {
     H3D Hb = H3D::Zero();
     for (int j = 0; j < N; ++j)
       if (H[j]) Hb.template middleCols<kStateDim>(kStateDim * j) = *H[j];
+    Eigen::Matrix<double, D, 1> mask;
+    if (gain_mask)
+      for (int j = 0; j < N; ++j) mask.template segment<kStateDim>(kStateDim * j) = *(*gain_mask)[j];
     // The one EKF update (filter/ekf_update.hpp) over the stacked error state; the error
     // estimate starts at zero (every subsystem is fed back after each update).
     Eigen::Matrix<double, D, 1> dxb = Eigen::Matrix<double, D, 1>::Zero();
     Eigen::Matrix<double, D, 3> K;
-    const UpdateReport rep = ekf_update<3, D>(P_, dxb, Hb, dz, R, gate, &K);
+    const UpdateReport rep = ekf_update<3, D>(P_, dxb, Hb, dz, R, gate, &K, gain_mask ? &mask : nullptr);
     if (rep.accepted) {
       S_ -= K * (Hb * S_);
       dirty_.fill(true);
@@ -153,7 +156,15 @@ UpdateReport CentralizedFilter::fuse(const Measurement& m) {
   std::array<const H3*, kMaxCentralized> blocks{};
   for (int j = 0; j < m.n; ++j) blocks[j] = &m.H[j];
   std::array<Vec21, kMaxCentralized> dx;
-  const UpdateReport rep = joint_->update(blocks, m.dz, m.R, m.gate, dx);
+  // A velocity update leaves every subsystem's consider states (velocity_gain) alone.
+  std::array<const Vec21*, kMaxCentralized> masks{};
+  bool consider = false;
+  for (int j = 0; j < subs_.size(); ++j) {
+    masks[j] = &subs_[j].process_noise().velocity_gain;
+    consider = consider || subs_[j].process_noise().velocity_consider();
+  }
+  const UpdateReport rep =
+      joint_->update(blocks, m.dz, m.R, m.gate, dx, m.velocity && consider ? &masks : nullptr);
   if (rep.accepted)
     for (int j = 0; j < subs_.size(); ++j) subs_[j].ekf().feedback(dx[j]);
   return rep;

@@ -36,10 +36,11 @@ class JointCovariance {
   /// Subsystem i advanced by one epoch (F_i over dt); the others did not move.
   virtual void propagate(int i, const ErrorDynamics& d, const ProcessNoise& q, double dt) = 0;
   /// Fuses dz = sum_j H_j dx_j + e (H[j] == nullptr: no dependence on subsystem j),
-  /// writing each subsystem's error estimate into dx[j].
+  /// writing each subsystem's error estimate into dx[j]. With `gain_mask`, subsystem j's
+  /// states whose (*gain_mask)[j] entry is 0 are consider states of this update.
   virtual UpdateReport update(const std::array<const H3*, kMaxCentralized>& H, const Vec3& dz,
-                              const Mat3& R, double gate,
-                              std::array<Vec21, kMaxCentralized>& dx) = 0;
+                              const Mat3& R, double gate, std::array<Vec21, kMaxCentralized>& dx,
+                              const std::array<const Vec21*, kMaxCentralized>* gain_mask) = 0;
 };
 
 /// A joint covariance for n subsystems (2 <= n <= kMaxCentralized); InputError otherwise.

@@ -26,7 +26,11 @@ class DistributedFilter final : public FilterBackend {
     return subs_[i].ekf().reported_covariance();
   }
   UpdateReport fuse(const Measurement& m) override {
-    return subs_[m.module].ekf().update<3>(m.H_own, m.dz, m.R, m.gate);
+    // A velocity update leaves the subsystem's consider states (velocity_gain) alone.
+    const ProcessNoise& q = subs_[m.module].process_noise();
+    const bool mask = m.velocity && q.velocity_consider();
+    return subs_[m.module].ekf().update<3>(m.H_own, m.dz, m.R, m.gate,
+                                           mask ? &q.velocity_gain : nullptr);
   }
   void restarted(int) override {}
 

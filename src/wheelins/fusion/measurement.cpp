@@ -67,6 +67,7 @@ void take_reference(const Subsystems& subs, SharedInputs& sh) {
 void velocity_measurement(const Subsystems& subs, const SharedInputs& sh, const FusionOptions& o,
                           int i, bool mean_offset_noise, Measurement& m) {
   m.reset(i, subs.size());
+  m.velocity = true;
   const SpeedSelection& sel = sh.speeds;
   const int n_mean = sel.n_mean;
   bool mean = false;  // the measured speed is the mean: its sensitivities are added below

@@ -29,6 +29,7 @@ struct Measurement {
   Vec3 dz = Vec3::Zero();
   Mat3 R = Mat3::Identity();
   double gate = 0.0;        ///< test-ratio gate; 0 = off
+  bool velocity = false;    ///< a velocity + NHC measurement (else the position constraint)
   /// The subsystem's own design matrix, the paper's H_v / H_mlt (Appendix B): the shared
   /// quantities (the other wheels' speeds, the Body-INS level, the fused reference point)
   /// taken as given. What the distributed filter fuses into subsystem `module`.
@@ -42,6 +43,7 @@ struct Measurement {
   void reset(int i, int n_subsystems) {
     module = i;
     n = n_subsystems;
+    velocity = false;
     for (int j = 0; j < n; ++j) H[j].setZero();
   }
 };

@@ -17,15 +17,26 @@ std::vector<double> configured_weights(const Subsystems& subs) {
 }
 }  // namespace
 
+namespace {
+/// The options with what depends on the selection decided (NavigatorOptions::resolved).
+NavigatorOptions resolve(const NavigatorOptions& o, const VehicleSetup& setup,
+                         const std::vector<std::string>& modules) {
+  bool body = false;
+  for (const auto& name : modules)
+    if (const ImuModule* m = setup.find(name)) body = body || m->kind == ModuleKind::kBody;
+  return o.resolved(static_cast<int>(modules.size()), body);
+}
+}  // namespace
+
 Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& modules,
                      const NavigatorOptions& options, Sink sink)
-    : opt_(options),
+    : opt_(resolve(options, setup, modules)),
       frame_(setup.origin),
       source_(setup.source),
       static_start_(setup.static_start),
       static_end_(setup.static_end),
       initial_heading_(setup.initial_heading),
-      subs_(setup, modules, options),
+      subs_(setup, modules, opt_),
       filter_(make_filter_backend(subs_, options.fusion.centralized)),
       output_(subs_, *filter_, frame_, opt_, std::move(sink)),
       faults_(make_fault_handler(opt_.faults, subs_, *filter_, output_)),

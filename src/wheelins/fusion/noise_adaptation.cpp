@@ -170,8 +170,10 @@ ModuleNoiseReport NoiseAdaptation::report(int i) const {
   r.nis_axes = st.matcher.nis_axes();
   r.velocity = st.velocity;
   r.position = st.position;
-  for (int k = 0; k < kStateDim; ++k)
+  for (int k = 0; k < kStateDim; ++k) {
     if (s.process_noise().held(k)) r.held.push_back(k);
+    else if (s.process_noise().velocity_gain(k) == 0.0) r.constraint_only.push_back(k);
+  }
   r.excursions = st.excursions;
   // Where the noise model and the data disagree, and what to change.
   char w[400];

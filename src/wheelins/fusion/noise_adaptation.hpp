@@ -61,6 +61,7 @@ struct ModuleNoiseReport {
   Vec3 nis_axes = Vec3::Ones();       ///< mean dz_i^2 / S_i over the last window
   MeasurementConsistency velocity, position;
   std::vector<int> held;              ///< error states not estimated
+  std::vector<int> constraint_only;   ///< estimated from the position constraint alone
   std::vector<PriorExcursion> excursions;
   std::vector<std::string> warnings;  ///< the noise model and the data disagree: what to change
 };

@@ -7,13 +7,50 @@
 
 namespace wheelins {
 
+namespace {
+const char* describe_yaw(YawScaleFactorChoice c) {
+  switch (c) {
+    case YawScaleFactorChoice::kAuto:
+      return "from the position constraint with a Body-IMU in the distributed filter, else held "
+             "(unobservable without a heading reference)";
+    case YawScaleFactorChoice::kHeld: return "held (unobservable without a heading reference)";
+    case YawScaleFactorChoice::kFromConstraint: return "from the position constraint only";
+    case YawScaleFactorChoice::kEstimated: return "estimated from every update";
+  }
+  return "?";
+}
+}  // namespace
+
+NavigatorOptions NavigatorOptions::resolved(int n_modules, bool has_body) const {
+  NavigatorOptions o = *this;
+  YawScaleFactors mode = YawScaleFactors::kHeld;
+  switch (yaw_scale_factors) {
+    case YawScaleFactorChoice::kAuto:
+      // Without a heading reference the vehicle's yaw-rate scale factor is a heading error that
+      // no measurement shows, and held it is carried as a consider term outside the gains. But
+      // the constraint shows the difference of the IMUs' headings; a Body-IMU's heading then
+      // counts only if every subsystem's covariance holds its own yaw-scale uncertainty (else
+      // the Body-INS, whose yaw bias drifts, follows the Wheel-INSs). Two Wheel-IMUs alone have
+      // equal priors: estimated or held, their mean heading is the same. The centralized
+      // filter lost heading with it (docs/accuracy.md), so it holds them.
+      if (fusion.position_constraint && !fusion.centralized && has_body && n_modules >= 2)
+        mode = YawScaleFactors::kFromConstraint;
+      break;
+    case YawScaleFactorChoice::kHeld: mode = YawScaleFactors::kHeld; break;
+    case YawScaleFactorChoice::kFromConstraint: mode = YawScaleFactors::kFromConstraint; break;
+    case YawScaleFactorChoice::kEstimated: mode = YawScaleFactors::kEstimated; break;
+  }
+  o.wheel.yaw_scale_factors = o.body.yaw_scale_factors = mode;
+  return o;
+}
+
 std::string NavigatorOptions::describe() const {
   std::ostringstream o;
   auto onoff = [](bool b) { return b ? "on" : "off"; };
   o << "velocity update interval:   " << wheel.velocity_update_interval << " s\n"
     << "wheel speed window:         " << wheel.speed_window << " s\n"
     << "wheel speed sharing:        "
-    << (fusion.speed == SpeedSharing::kMean ? "mean of Wheel-IMUs (paper)" : "own wheel") << "\n"
+    << (fusion.speed == SpeedSharing::kMean ? "mean of Wheel-IMUs (paper)" : "own wheel (Body-INS: their mean)") << "\n"
     << "Wheel-INS velocity sigma:   " << wheel.velocity_std.transpose() << " m/s\n"
     << "Body-INS velocity sigma:    " << body.velocity_std.transpose() << " m/s\n"
     << "position constraint:        " << onoff(fusion.position_constraint) << ", every "
@@ -46,9 +83,7 @@ std::string NavigatorOptions::describe() const {
                             std::to_string(static_cast<int>(noise.window)) + " updates)"
                       : std::string("the given figures, held fixed"))
     << "\n"
-    << "yaw-rate scale factors:     "
-    << (wheel.estimate_yaw_scale_factor ? "estimated" : "held (unobservable without a heading reference)")
-    << "\n"
+    << "yaw-rate scale factors:     " << describe_yaw(yaw_scale_factors) << "\n"
     << "axle accelerometer SF:      "
     << (wheel.estimate_axle_accel_scale_factor ? "estimated" : "held (not told from its bias on one-way turns)")
     << "\n"

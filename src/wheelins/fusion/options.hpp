@@ -21,6 +21,16 @@ enum class SpeedSharing {
   kOwn,   ///< each Wheel-INS its own wheel's speed; a Body-INS the mean, at the mean wheel point
 };
 
+/// The yaw-rate scale factors of every subsystem (docs/filter.md 13.4).
+enum class YawScaleFactorChoice {
+  /// From the position constraint where a Body-IMU's heading takes part in it (the distributed
+  /// filter with the constraint on, over a Body-IMU and at least one Wheel-IMU); held otherwise.
+  kAuto,
+  kHeld,            ///< YawScaleFactors::kHeld everywhere
+  kFromConstraint,  ///< YawScaleFactors::kFromConstraint everywhere
+  kEstimated,       ///< YawScaleFactors::kEstimated everywhere
+};
+
 /// Where the reference weights k_i of eq. (8) come from.
 enum class ReferenceWeighting {
   kFixed,       ///< FusionOptions::weights (empty: equal), the paper
@@ -28,7 +38,9 @@ enum class ReferenceWeighting {
 };
 
 struct FusionOptions {
-  SpeedSharing speed = SpeedSharing::kMean;
+  /// Own by default: the mean is off by +-omega_yaw * track / 2 at each wheel in a turn, an
+  /// error that follows the turns like a yaw-rate scale factor (docs/filter.md section 9).
+  SpeedSharing speed = SpeedSharing::kOwn;
   bool share_level = true;                ///< Body-INS roll/pitch to the Wheel-INSs
   bool position_constraint = true;
   double position_update_interval = 1.0;  ///< [s]; the paper's 1 Hz
@@ -55,9 +67,12 @@ struct NoiseAdaptationOptions {
 };
 
 struct NavigatorOptions {
+  /// The Wheel-INS and Body-INS settings; their yaw_scale_factors are set from
+  /// `yaw_scale_factors` by resolved().
   WheelInsOptions wheel;
   BodyInsOptions body;
   FusionOptions fusion;
+  YawScaleFactorChoice yaw_scale_factors = YawScaleFactorChoice::kAuto;
   MechanizationOptions::Method mechanization = MechanizationOptions::Method::kRotationExact;
   /// Compensate the earth rotation (the manifest says whether the data contain it).
   bool earth_rotation = true;
@@ -74,6 +89,9 @@ struct NavigatorOptions {
   /// updates always see P propagated to their epoch. At most kMaxCovarianceInterval.
   double covariance_interval = 0.05;
   static constexpr double kMaxCovarianceInterval = 0.5;  ///< [s]
+  /// These options for a navigator over `n_modules` modules, `has_body` when one is a
+  /// Body-IMU: wheel/body.yaw_scale_factors set from `yaw_scale_factors` (kAuto decided here).
+  NavigatorOptions resolved(int n_modules, bool has_body) const;
   /// The options in human units (OpenVINS style), one per line.
   std::string describe() const;
   /// Throws InputError naming the option if a value is out of range (the fault options

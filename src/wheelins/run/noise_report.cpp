@@ -102,6 +102,10 @@ std::string noise_report_yaml(const std::vector<ModuleNoiseReport>& reports,
     o << "    not_estimated: [";
     for (std::size_t k = 0; k < r.held.size(); ++k) o << (k ? ", " : "") << error_state_name(r.held[k]);
     o << "]  # held at 0 (docs/filter.md 13.4: yaw-rate scale factors, the axle accelerometer's)\n";
+    o << "    from_constraint_only: [";
+    for (std::size_t k = 0; k < r.constraint_only.size(); ++k)
+      o << (k ? ", " : "") << error_state_name(r.constraint_only[k]);
+    o << "]  # estimated from the position constraint, not the velocity updates (13.4)\n";
     o << "    beyond_3_sigma:";
     if (r.excursions.empty()) o << " []";
     o << "\n";

@@ -11,6 +11,17 @@ namespace fs = std::filesystem;
 
 namespace {
 /// Ranges shared with the command line (app/cmd_run.cpp checks the same).
+const std::vector<std::pair<std::string, YawScaleFactorChoice>> kYawChoices = {
+    {"auto", YawScaleFactorChoice::kAuto},
+    {"held", YawScaleFactorChoice::kHeld},
+    {"constraint", YawScaleFactorChoice::kFromConstraint},
+    {"estimated", YawScaleFactorChoice::kEstimated}};
+
+YawScaleFactorChoice yaw_scale_factors_from(const YamlReader& y, const YAML::Node& v,
+                                            const std::string& key) {
+  return y.choice<YawScaleFactorChoice>(v, key, kYawChoices);
+}
+
 struct Ranges {
   double duration[2] = {0.0, 1e7};
   double output_interval[2] = {0.0, 5.0};
@@ -21,6 +32,12 @@ SpeedSharing speed_sharing_from_name(const std::string& name) {
   if (name == "mean") return SpeedSharing::kMean;
   if (name == "own") return SpeedSharing::kOwn;
   throw InputError("wheel speed sharing '" + name + "': expected mean or own");
+}
+
+YawScaleFactorChoice yaw_scale_factors_from_name(const std::string& name) {
+  for (const auto& [n, c] : kYawChoices)
+    if (name == n) return c;
+  throw InputError("yaw scale factors '" + name + "': expected auto, held, constraint or estimated");
 }
 
 ReferenceWeighting weighting_from_name(const std::string& name) {
@@ -77,14 +94,23 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     y.check_keys(f, "filter",
                  {"mechanization", "earth_rotation", "velocity_update_hz", "speed_window_s",
                   "wheel_velocity_std_m_s", "body_velocity_std_m_s", "velocity_gate",
-                  "initial_std", "covariance_interval_s", "estimate_yaw_scale_factors",
-                  "estimate_axle_accel_scale_factors"});
+                  "initial_std", "covariance_interval_s", "yaw_scale_factors",
+                  "estimate_yaw_scale_factors", "estimate_axle_accel_scale_factors"});
     if (auto v = y.get(f, "estimate_axle_accel_scale_factors"); v.IsDefined())
       c.nav.wheel.estimate_axle_accel_scale_factor =
           y.boolean(v, "filter.estimate_axle_accel_scale_factors");
-    if (auto v = y.get(f, "estimate_yaw_scale_factors"); v.IsDefined())
-      c.nav.wheel.estimate_yaw_scale_factor = c.nav.body.estimate_yaw_scale_factor =
-          y.boolean(v, "filter.estimate_yaw_scale_factors");
+    const YAML::Node yaw = y.get(f, "yaw_scale_factors");
+    if (yaw.IsDefined())
+      c.nav.yaw_scale_factors = yaw_scale_factors_from(y, yaw, "filter.yaw_scale_factors");
+    if (auto v = y.get(f, "estimate_yaw_scale_factors"); v.IsDefined()) {
+      // The older spelling: true = estimated, false = held.
+      if (yaw.IsDefined())
+        y.fail("filter.estimate_yaw_scale_factors",
+               "conflicts with filter.yaw_scale_factors (give only the latter)", &v);
+      c.nav.yaw_scale_factors = y.boolean(v, "filter.estimate_yaw_scale_factors")
+                                    ? YawScaleFactorChoice::kEstimated
+                                    : YawScaleFactorChoice::kHeld;
+    }
     if (auto v = y.get(f, "mechanization"); v.IsDefined())
       c.nav.mechanization = y.choice<MechanizationOptions::Method>(
           v, "filter.mechanization",

@@ -30,6 +30,8 @@ struct RunConfig {
 RunConfig load_run_config(const std::filesystem::path& file, const WarningSink& warn);
 
 SpeedSharing speed_sharing_from_name(const std::string& name);
+/// `auto`, `held`, `constraint` or `estimated` (docs/filter.md 13.4); InputError otherwise.
+YawScaleFactorChoice yaw_scale_factors_from_name(const std::string& name);
 /// `equal` (the paper) or `covariance` (reference_weights.hpp); InputError otherwise.
 ReferenceWeighting weighting_from_name(const std::string& name);
 

@@ -95,7 +95,7 @@ struct Job {
 struct ExperimentSpec {
   std::filesystem::path dataset;
   std::vector<std::string> only;
-  std::string speed = "mean";
+  std::string speed = "own";  ///< the run default (FusionOptions::speed)
   double duration = 0.0;
 };
 
