@@ -16,13 +16,13 @@ std::vector<std::string> names_of(const Subsystems& subs) {
 }  // namespace
 
 std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, Subsystems& subs,
-                                                 FilterBackend& filter, const OutputFusion& output) {
+                                                 FilterBackend& filter, OutputFusion& output) {
   if (options.enabled) return std::make_unique<FaultPolicy>(options, subs, filter, output);
   return std::make_unique<NoFaultHandling>(names_of(subs), options);
 }
 
 FaultPolicy::FaultPolicy(const FaultOptions& options, Subsystems& subs, FilterBackend& filter,
-                         const OutputFusion& output)
+                         OutputFusion& output)
     : FaultHandler(FaultMonitor(names_of(subs), options)),
       opt_(options),
       subs_(subs),
@@ -254,6 +254,8 @@ void FaultPolicy::isolate(int i, double t, const std::string& what) {
   monitor_.clear_tests(i);
   rt_[i].revert_errors = true;
   rt_[i].heading_fails = 0;
+  // Its heading offset was tracked while the fault went undetected: not to be trusted.
+  output_.forget_heading_offset(i);
 }
 
 void FaultPolicy::on_position_step(double t) {
@@ -306,7 +308,11 @@ VehicleFix FaultPolicy::vehicle_fix(int i, double t) const {
     const TrajectoryRecord r = output_.fused(use);
     fix.p_OinW = r.p_inN + r.v_inN * (t - r.t);
     fix.v_OinW = r.v_inN;
-    fix.heading = r.rpy.z();
+    // The mean heading of all modules (fused() carries it through the outage) plus this
+    // module's own offset from it before the outage: what the others' gyros say it turned
+    // by since. Its yaw-rate scale factor's share of its heading is kept, not lost to theirs.
+    double offset = 0.0;
+    fix.heading = wrap_pi(r.rpy.z() + (output_.heading_offset(i, offset) ? offset : 0.0));
     fix.position_std = r.p_std.norm() + 0.05;
     fix.heading_std = r.rpy_std.z() + 0.5 * kDeg;
     return fix;

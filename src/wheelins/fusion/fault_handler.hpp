@@ -81,7 +81,7 @@ class FaultPolicy final : public FaultHandler {
  public:
   /// `subs`, `filter` and `output` are the navigator's; they must outlive the policy.
   FaultPolicy(const FaultOptions& options, Subsystems& subs, FilterBackend& filter,
-              const OutputFusion& output);
+              OutputFusion& output);
 
   void on_start(double t0) override;
   bool on_sample(int i, const ImuSample& raw, ImuSample& b) override;
@@ -122,7 +122,7 @@ class FaultPolicy final : public FaultHandler {
   FaultOptions opt_;
   Subsystems& subs_;
   FilterBackend& filter_;
-  const OutputFusion& output_;
+  OutputFusion& output_;
   std::vector<Runtime> rt_;
   bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
   std::array<bool, kMaxModules> excused_{};  ///< saturated or recovering this step
@@ -130,6 +130,6 @@ class FaultPolicy final : public FaultHandler {
 
 /// FaultPolicy when options.enabled, else NoFaultHandling.
 std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, Subsystems& subs,
-                                                 FilterBackend& filter, const OutputFusion& output);
+                                                 FilterBackend& filter, OutputFusion& output);
 
 }  // namespace wheelins

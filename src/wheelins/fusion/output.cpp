@@ -84,10 +84,37 @@ TrajectoryRecord OutputFusion::fused(const Use& use) const {
   return fuse(use, recs);
 }
 
+bool OutputFusion::heading_offset(int i, double& offset) const {
+  if (!offset_valid_[i]) return false;
+  offset = offset_[i];
+  return true;
+}
+
+void OutputFusion::track_offsets(double t, const Use& vehicle, const Records& recs) {
+  const int n = subs_.size();
+  if (n < 2) return;
+  for (int i = 0; i < n; ++i)
+    if (!vehicle[i]) return;  // the offsets are to the mean of all of them
+  double s = 0.0, c = 0.0;
+  for (int i = 0; i < n; ++i) {
+    s += subs_.weight(i) * std::sin(recs[i].rpy.z());
+    c += subs_.weight(i) * std::cos(recs[i].rpy.z());
+  }
+  const double mean = std::atan2(s, c);
+  const double a = std::clamp((t - offset_t_) / kOffsetWindow, 0.0, 1.0);
+  for (int i = 0; i < n; ++i) {
+    // A new (or forgotten) offset starts from its present value.
+    offset_[i] += (offset_valid_[i] ? a : 1.0) * wrap_pi(wrap_pi(recs[i].rpy.z() - mean) - offset_[i]);
+    offset_valid_[i] = true;
+  }
+  offset_t_ = t;
+}
+
 void OutputFusion::write(double t, const Use& vehicle, const Use& in_use) {
   const int n = subs_.size();
   const bool modules_out = n > 1 && module_records_;
   collect(vehicle, modules_out ? &in_use : nullptr, recs_);
+  track_offsets(t, vehicle, recs_);
   TrajectoryRecord v = fuse(vehicle, recs_);
   v.t = t;  // the epoch of the module driving the output
   sink_(0, v);
@@ -140,6 +167,16 @@ TrajectoryRecord OutputFusion::fuse(const Use& use, const Records& recs) const {
   r.v_std = v_std;
   r.rpy.z() = std::atan2(s, c);
   r.rpy_std.z() = psi_std;
+  bool known = n_use < subs_.size();
+  for (int i = 0; i < subs_.size(); ++i) known = known && offset_valid_[i];
+  if (known) {
+    // Modules are missing: psi_i = psi_all + offset_i, so the mean of all of them is the mean
+    // of these less the mean of their offsets (the heading goes on as if they were there).
+    double o = 0.0;
+    for (int i = 0; i < subs_.size(); ++i)
+      if (use[i]) o += subs_.weight(i) / ksum * offset_[i];
+    r.rpy.z() = wrap_pi(r.rpy.z() - o);
+  }
   if (body_index >= 0) {
     const Vec3 rpy = subs_.body().vehicle_rpy();
     r.rpy.head<2>() = rpy.head<2>();

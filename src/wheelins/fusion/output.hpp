@@ -26,8 +26,19 @@ class OutputFusion {
   /// Subsystem i's own solution; without lat/lon/h (left NaN) when with_lla is false.
   TrajectoryRecord record(int i, bool with_lla = true) const;
   /// The weighted mean of the subsystems in `use` (the vehicle solution when `use` holds the
-  /// modules that count).
+  /// modules that count). Its heading, when `use` lacks modules, is the mean heading of all
+  /// of them as estimated from each one's offset (heading_offset()): continuous through an
+  /// outage.
   TrajectoryRecord fused(const Use& use) const;
+  /// Subsystem i's heading less the weighted mean heading of all subsystems, averaged over
+  /// the last kOffsetWindow seconds in which all of them counted (frozen while not); false
+  /// before it has been seen. A module that comes back after an outage restarts from the
+  /// others' heading plus its offset (fault_handler.cpp).
+  bool heading_offset(int i, double& offset) const;
+  static constexpr double kOffsetWindow = 30.0;  ///< [s], e-folding
+  /// Subsystem i's offset is not known (it was isolated: a fault may have moved its heading
+  /// before it was detected) until all subsystems count again.
+  void forget_heading_offset(int i) { offset_valid_[i] = false; }
   /// One output epoch at time t: the vehicle record (the mean over `vehicle`) and, of a
   /// multi-IMU run with module records, each subsystem's in `in_use` that has new data.
   void write(double t, const Use& vehicle, const Use& in_use);
@@ -39,6 +50,8 @@ class OutputFusion {
   void collect(const Use& use, const Use* also, Records& recs) const;
   /// The mean from records already made (recs[i] valid where use[i], and recs[first]).
   TrajectoryRecord fuse(const Use& use, const Records& recs) const;
+  /// With every subsystem in `vehicle`, the offsets move toward their headings' at time t.
+  void track_offsets(double t, const Use& vehicle, const Records& recs);
 
   const Subsystems& subs_;
   const FilterBackend& filter_;
@@ -47,6 +60,9 @@ class OutputFusion {
   Sink sink_;
   Records recs_{};                              ///< scratch of write() (no allocation per epoch)
   std::array<double, kMaxModules> last_record_t_;  ///< time of each subsystem's last record
+  std::array<double, kMaxModules> offset_{};       ///< heading_offset() [rad]
+  std::array<bool, kMaxModules> offset_valid_{};
+  double offset_t_ = 0.0;                          ///< time of the last tracking step
 };
 
 }  // namespace wheelins
