@@ -170,11 +170,17 @@ VehicleConfig VehicleConfig::preset_named(const std::string& name) {
   return v;
 }
 
+ErrorParams profile_errors(const std::string& profile) {
+  profile_effects(profile);  // the name checked
+  ErrorParams e;
+  if (profile == "field") e.gyro_sf = 3000e-6;
+  return e;
+}
+
 void SimConfig::set_profile(const std::string& name) {
   effects = profile_effects(name);
   profile = name;
-  errors = ErrorParams{};
-  if (name == "field") errors.gyro_sf = 3000e-6;
+  errors = profile_errors(name);
 }
 
 void SimConfig::disable(const std::vector<std::string>& names) {

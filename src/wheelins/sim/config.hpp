@@ -87,6 +87,10 @@ struct ErrorParams {
   double cal_radius_rel = 0.003;     ///< [-]
 };
 
+/// The error parameters of a profile ("ideal", "datasheet", "field"): the defaults above,
+/// with the field profile's gyro scale factor raised to 3000 ppm. InputError for another name.
+ErrorParams profile_errors(const std::string& profile);
+
 /// One physical module (a group of four chips).
 struct ModuleGeometry {
   std::string group;            ///< "left-wheel", "right-wheel", "body"
@@ -120,7 +124,7 @@ struct SimConfig {
   double gps_week = 2200;
   bool earth_rotation = true;
   VehicleConfig vehicle = VehicleConfig::preset_named("robot");
-  ErrorParams errors;
+  ErrorParams errors = profile_errors("field");
   // scenario shape
   double static_duration = 30.0;
   int laps = 5;
