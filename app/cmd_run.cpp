@@ -196,7 +196,7 @@ const bool registered = cli::register_command(
       sub.add_option("--speed", a->speed, "Wheel speed sharing: own (default) | mean (paper)");
       sub.add_option("--yaw-scale-factors", a->yaw,
                      "Yaw-rate scale factors: auto (default: from the position constraint with a "
-                     "Body-IMU, distributed filter; else held) | held | constraint | estimated");
+                     "Body-IMU, else held) | held | constraint | estimated");
       sub.add_option("--weights", a->weights,
                      "Reference weights k_i of eq. (8): equal (paper) | covariance (each "
                      "subsystem's own uncertainty; weights.csv)");

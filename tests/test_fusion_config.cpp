@@ -151,8 +151,8 @@ TEST(FusionRunConfig, YawScaleFactorsAndTheOlderKey) {
 }
 
 TEST(FusionNavigator, YawScaleFactorsResolvedByConfiguration) {
-  // auto: from the constraint in the distributed filter when a Body-IMU and another module
-  // are in it; held otherwise; an explicit choice is taken as given.
+  // auto: from the constraint when a Body-IMU and another module are in it (either filter);
+  // held otherwise; an explicit choice is taken as given.
   NavigatorOptions o;
   auto mode = [](const NavigatorOptions& r) {
     EXPECT_EQ(r.wheel.yaw_scale_factors, r.body.yaw_scale_factors);
@@ -164,13 +164,14 @@ TEST(FusionNavigator, YawScaleFactorsResolvedByConfiguration) {
   EXPECT_EQ(mode(o.resolved(1, false)), YawScaleFactors::kHeld);
   NavigatorOptions c = o;
   c.fusion.centralized = true;
-  EXPECT_EQ(mode(c.resolved(3, true)), YawScaleFactors::kHeld);
+  EXPECT_EQ(mode(c.resolved(3, true)), YawScaleFactors::kFromConstraint);
+  EXPECT_EQ(mode(c.resolved(2, false)), YawScaleFactors::kHeld);
   NavigatorOptions n = o;
   n.fusion.position_constraint = false;
   EXPECT_EQ(mode(n.resolved(3, true)), YawScaleFactors::kHeld);
   NavigatorOptions e = c;
   e.yaw_scale_factors = YawScaleFactorChoice::kFromConstraint;
-  EXPECT_EQ(mode(e.resolved(3, true)), YawScaleFactors::kFromConstraint);
+  EXPECT_EQ(mode(e.resolved(2, false)), YawScaleFactors::kFromConstraint);
   e.yaw_scale_factors = YawScaleFactorChoice::kEstimated;
   EXPECT_EQ(mode(e.resolved(1, false)), YawScaleFactors::kEstimated);
   e.yaw_scale_factors = YawScaleFactorChoice::kHeld;

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "io_test_util.hpp"
+#include "wheelins/fusion/centralized.hpp"
 #include "wheelins/fusion/reference_weights.hpp"
 #include "wheelins/run/run_config.hpp"
 
@@ -25,6 +26,31 @@ FusionOptions covariance_weighting(double window = 60.0) {
 }
 
 }  // namespace
+
+TEST(JointCovarianceCondition, TheMeanYawScaleFactorIsHeldAndTheDifferencesStay) {
+  // Three independent yaw-rate scale factors of variance s2 (one state of each IMU's block):
+  // conditioned on their mean (CentralizedFilter::hold_common_yaw_scale_factor), each keeps
+  // 2/3 of its variance and the mean has none left (to its floor r = 1e-10); a second
+  // conditioning changes nothing; other states are untouched.
+  auto joint = make_joint_covariance(3);
+  const double s2 = 3000e-6 * 3000e-6;
+  Mat21 P = Mat21::Identity() * 1e-4;
+  P(SG + 2, SG + 2) = s2;
+  for (int i = 0; i < 3; ++i) joint->set_block(i, P);
+  std::array<Eigen::Matrix<double, 1, kStateDim>, kMaxCentralized> h{};
+  for (int i = 0; i < 3; ++i) {
+    h[i].setZero();
+    h[i](SG + 2) = 1.0 / 3.0;
+  }
+  joint->condition(h);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(joint->block(i)(SG + 2, SG + 2), s2 * 2.0 / 3.0, 1e-3 * s2);
+    EXPECT_EQ(joint->block(i)(V, V), 1e-4);
+  }
+  const Mat21 before = joint->block(1);
+  joint->condition(h);
+  EXPECT_EQ(joint->block(1), before) << "the mean's variance is below the floor already";
+}
 
 TEST(ReferenceWeights, VarianceOfTheReferencePointIsItsHorizontalTrace) {
   // o = r_b + a heading lever: H has I in the position block and a column in phi_z.

@@ -188,11 +188,11 @@ TEST_F(NoiseAdaptationEndToEnd, IdentifiesTheNoiseTheManifestDoesNotState) {
 TEST_F(NoiseAdaptationEndToEnd, YawRateScaleFactorsByConfiguration) {
   // A Wheel-IMU's y and z gyro scale factors and the Body-IMU's along the vehicle's yaw axis
   // (the yaw-rate scale factors) and the Wheel-IMU's axle accelerometer's are not estimated
-  // where nothing shows them: single Wheel-INS, and the centralized filter. Their estimates
-  // stay exactly 0 and their rows of P are 0. In the distributed filter with a Body-IMU in
-  // the position constraint (auto) the yaw-rate scale factors are estimated, from the
-  // constraint alone: they move, with a covariance, while the axle accelerometer's stays
-  // held. The options override the choice.
+  // where nothing shows them: single Wheel-INS, Wheel-IMUs alone. Their estimates stay
+  // exactly 0 and their rows of P are 0. With a Body-IMU in the position constraint (auto,
+  // either filter) the yaw-rate scale factors are estimated, from the constraint alone: they
+  // move, with a covariance, while the axle accelerometer's stays held. The options
+  // override the choice.
   const fs::path file = data_->dir / "manifest-none.yaml";
   const Manifest m = load_manifest(file, {});
   struct Case {
@@ -201,13 +201,15 @@ TEST_F(NoiseAdaptationEndToEnd, YawRateScaleFactorsByConfiguration) {
     YawScaleFactorChoice choice;
     bool from_constraint;  ///< the yaw-rate scale factors estimated from the constraint
   };
-  for (const Case& c : {Case{"triple", true, YawScaleFactorChoice::kAuto, false},
+  for (const Case& c : {Case{"triple", true, YawScaleFactorChoice::kHeld, false},
+                        Case{"triple", true, YawScaleFactorChoice::kAuto, true},
                         Case{"single", false, YawScaleFactorChoice::kAuto, false},
                         Case{"dual-wheel", false, YawScaleFactorChoice::kAuto, false},
                         Case{"triple", false, YawScaleFactorChoice::kHeld, false},
                         Case{"triple", false, YawScaleFactorChoice::kAuto, true},
                         Case{"body-wheel", false, YawScaleFactorChoice::kAuto, true},
-                        Case{"dual-wheel", false, YawScaleFactorChoice::kFromConstraint, true}}) {
+                        Case{"dual-wheel", false, YawScaleFactorChoice::kFromConstraint, true},
+                        Case{"dual-wheel", true, YawScaleFactorChoice::kAuto, false}}) {
     SCOPED_TRACE(std::string(c.configuration) + (c.centralized ? " centralized" : "") +
                  (c.choice == YawScaleFactorChoice::kAuto ? " auto" : " explicit"));
     const auto modules = configuration_modules(m, c.configuration, {});

@@ -3,6 +3,7 @@
 // it implies (heading, reference point) with their measurement models.
 #pragma once
 
+#include <array>
 #include <initializer_list>
 
 #include "wheelins/filter/alignment.hpp"
@@ -99,6 +100,12 @@ class Subsystem {
 
   Vec3 reference_point_inW() const { return reference_point_model(reference_point_input()).r_o; }
 
+  /// What is done with the yaw-rate scale factor, and its error states (the mean of their
+  /// scale factors is the yaw-rate scale factor): b y, z of a Wheel-IMU, one axis of a Body-IMU.
+  YawScaleFactors yaw_scale_factor_mode() const { return yaw_mode_; }
+  const std::array<int, 2>& yaw_scale_factor_states() const { return yaw_states_; }
+  int yaw_scale_factor_state_count() const { return yaw_count_; }
+
   /// The noise model in use: the module's figures, as the noise identification has set them
   /// since (fusion/noise_adaptation.hpp), and which states are estimated. Restarts keep it.
   const ProcessNoise& process_noise() const { return noise_; }
@@ -112,9 +119,12 @@ class Subsystem {
   /// Applies `mode` to the error states `yaw_states` (the yaw-rate scale factor's) in the
   /// noise model: held (not estimated), or a consider state of the velocity updates.
   void set_yaw_scale_factor_mode(YawScaleFactors mode, std::initializer_list<int> yaw_states) {
+    yaw_mode_ = mode;
+    yaw_count_ = 0;
     for (int k : yaw_states) {
       if (mode == YawScaleFactors::kHeld) noise_.estimated(k) = 0.0;
       if (mode == YawScaleFactors::kFromConstraint) noise_.velocity_gain(k) = 0.0;
+      if (yaw_count_ < 2) yaw_states_[yaw_count_++] = k;
     }
   }
 
@@ -122,6 +132,9 @@ class Subsystem {
   MechanizationOptions mech_;
   ProcessNoise noise_;
   StrapdownEkf ekf_;
+  YawScaleFactors yaw_mode_ = YawScaleFactors::kHeld;
+  std::array<int, 2> yaw_states_{};
+  int yaw_count_ = 0;
 };
 
 }  // namespace wheelins

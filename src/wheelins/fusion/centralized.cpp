@@ -78,6 +78,18 @@ class FixedJointCovariance final : public JointCovariance {
     Pii = sym;
   }
 
+  void condition(const std::array<Eigen::Matrix<double, 1, kStateDim>, kMaxCentralized>& h) override {
+    Eigen::Matrix<double, 1, D> hb;
+    for (int j = 0; j < N; ++j) hb.template segment<kStateDim>(kStateDim * j) = h[j];
+    const Eigen::Matrix<double, D, 1> Ph = P_.lazyProduct(hb.transpose());
+    const double s = hb.dot(Ph);
+    constexpr double r = 1e-10;  // (10 ppm)^2: what is left of the combination's variance
+    if (!(s > r)) return;
+    P_ -= Ph.lazyProduct(Ph.transpose()) / (s + r);
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    dirty_.fill(true);
+  }
+
   UpdateReport update(const std::array<const H3*, kMaxCentralized>& H, const Vec3& dz,
                       const Mat3& R, double gate, std::array<Vec21, kMaxCentralized>& dx,
                       const std::array<const Vec21*, kMaxCentralized>* gain_mask) override {
@@ -156,6 +168,7 @@ UpdateReport CentralizedFilter::fuse(const Measurement& m) {
   std::array<const H3*, kMaxCentralized> blocks{};
   for (int j = 0; j < m.n; ++j) blocks[j] = &m.H[j];
   std::array<Vec21, kMaxCentralized> dx;
+  if (m.velocity) hold_common_yaw_scale_factor();
   // A velocity update leaves every subsystem's consider states (velocity_gain) alone.
   std::array<const Vec21*, kMaxCentralized> masks{};
   bool consider = false;
@@ -168,6 +181,26 @@ UpdateReport CentralizedFilter::fuse(const Measurement& m) {
   if (rep.accepted)
     for (int j = 0; j < subs_.size(); ++j) subs_[j].ekf().feedback(dx[j]);
   return rep;
+}
+
+void CentralizedFilter::hold_common_yaw_scale_factor() {
+  // The weighted mean of the subsystems' yaw-rate scale factors (those estimated from the
+  // constraint), what the vehicle heading's own scale factor is: nothing observes it, and in
+  // the joint covariance its variance lets the velocity updates of every stop and start turn
+  // all headings together (docs/filter.md 13.4). Conditioned out before each velocity update
+  // (its Gauss-Markov driving noise brings a little back in between); their differences stay.
+  std::array<Eigen::Matrix<double, 1, kStateDim>, kMaxCentralized> h{};
+  bool any = false;
+  for (int j = 0; j < subs_.size(); ++j) {
+    h[j].setZero();
+    const Subsystem& s = subs_[j];
+    if (s.yaw_scale_factor_mode() != YawScaleFactors::kFromConstraint) continue;
+    const auto& states = s.yaw_scale_factor_states();
+    for (int k = 0; k < s.yaw_scale_factor_state_count(); ++k)
+      h[j](states[k]) = subs_.weight(j) / s.yaw_scale_factor_state_count();
+    any = true;
+  }
+  if (any) joint_->condition(h);
 }
 
 void CentralizedFilter::restarted(int i) {

@@ -35,6 +35,10 @@ class JointCovariance {
   virtual const Mat21& reported_block(int i) const = 0;
   /// Subsystem i advanced by one epoch (F_i over dt); the others did not move.
   virtual void propagate(int i, const ErrorDynamics& d, const ProcessNoise& q, double dt) = 0;
+  /// Conditions P on a known linear combination c = sum_j h_j dx_j (no change to the
+  /// estimate): P <- P - P h^T (h P h^T + r)^-1 h P with r = (1e-5)^2, leaving c a variance
+  /// of about r (10 ppm for a scale factor); nothing if h P h^T is already below r.
+  virtual void condition(const std::array<Eigen::Matrix<double, 1, kStateDim>, kMaxCentralized>& h) = 0;
   /// Fuses dz = sum_j H_j dx_j + e (H[j] == nullptr: no dependence on subsystem j),
   /// writing each subsystem's error estimate into dx[j]. With `gain_mask`, subsystem j's
   /// states whose (*gain_mask)[j] entry is 0 are consider states of this update.
@@ -64,6 +68,9 @@ class CentralizedFilter final : public FilterBackend {
  private:
   /// Moves subsystem i's accumulated dynamics into the joint covariance.
   void propagate_joint(int i);
+  /// Conditions the joint covariance on the weighted mean of the yaw-rate scale factors
+  /// that are estimated from the constraint (none: nothing done).
+  void hold_common_yaw_scale_factor();
   Subsystems& subs_;
   std::unique_ptr<JointCovariance> joint_;
 };

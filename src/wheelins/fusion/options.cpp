@@ -11,7 +11,7 @@ namespace {
 const char* describe_yaw(YawScaleFactorChoice c) {
   switch (c) {
     case YawScaleFactorChoice::kAuto:
-      return "from the position constraint with a Body-IMU in the distributed filter, else held "
+      return "from the position constraint when it takes in a Body-IMU, else held "
              "(unobservable without a heading reference)";
     case YawScaleFactorChoice::kHeld: return "held (unobservable without a heading reference)";
     case YawScaleFactorChoice::kFromConstraint: return "from the position constraint only";
@@ -31,9 +31,9 @@ NavigatorOptions NavigatorOptions::resolved(int n_modules, bool has_body) const 
       // the constraint shows the difference of the IMUs' headings; a Body-IMU's heading then
       // counts only if every subsystem's covariance holds its own yaw-scale uncertainty (else
       // the Body-INS, whose yaw bias drifts, follows the Wheel-INSs). Two Wheel-IMUs alone have
-      // equal priors: estimated or held, their mean heading is the same. The centralized
-      // filter lost heading with it (docs/accuracy.md), so it holds them.
-      if (fusion.position_constraint && !fusion.centralized && has_body && n_modules >= 2)
+      // equal priors: estimated or held, their mean heading is the same. (The centralized
+      // filter holds their weighted mean: CentralizedFilter::hold_common_yaw_scale_factor.)
+      if (fusion.position_constraint && has_body && n_modules >= 2)
         mode = YawScaleFactors::kFromConstraint;
       break;
     case YawScaleFactorChoice::kHeld: mode = YawScaleFactors::kHeld; break;

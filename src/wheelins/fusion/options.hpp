@@ -23,8 +23,8 @@ enum class SpeedSharing {
 
 /// The yaw-rate scale factors of every subsystem (docs/filter.md 13.4).
 enum class YawScaleFactorChoice {
-  /// From the position constraint where a Body-IMU's heading takes part in it (the distributed
-  /// filter with the constraint on, over a Body-IMU and at least one Wheel-IMU); held otherwise.
+  /// From the position constraint where a Body-IMU's heading takes part in it (the constraint
+  /// on, over a Body-IMU and at least one Wheel-IMU); held otherwise.
   kAuto,
   kHeld,            ///< YawScaleFactors::kHeld everywhere
   kFromConstraint,  ///< YawScaleFactors::kFromConstraint everywhere
