@@ -53,7 +53,7 @@ class EvalCliTest : public ::testing::Test {
   }
   // Truth: north at 1 m/s for 300 s, heading 0; trajectory: east error 0.01 * s,
   // heading 1 deg too high. Drift: r_k = 0.01 k l / (k l) = 1 % for k = 1..3.
-  void make_files() {
+  void make_files(double sigma = 1.0) {
     const earth::Geodetic origin{30.5 * kDeg, 114.3 * kDeg, 20.0};
     const earth::LocalFrame frame(origin);
     TruthWriter tw(dir_ / "GINS.bin", false, 2200);
@@ -69,7 +69,7 @@ class EvalCliTest : public ::testing::Test {
       r.p_inN = Vec3(i, 0.01 * i, 0);
       r.lla = frame.geodetic_from_ned(r.p_inN);
       r.rpy = Vec3(0, 0, 1.0 * kDeg);
-      r.p_std = Vec3(1, 1, 1);
+      r.p_std = Vec3(sigma, sigma, sigma);
       w->write(r);
     }
     tw.commit();
@@ -125,6 +125,26 @@ TEST_F(EvalCliTest, TableAndJson) {
   EXPECT_EQ(forced.code, 0) << forced.err;
   EXPECT_NEAR(json_value(slurp(dir_ / "m.json"), "segment_m"), 100.0, 0.0);
   EXPECT_EQ(slurp(dir_ / "s.csv").rfind("t_s,distance_m,err_n_m", 0), 0u);
+}
+
+// The east error 0.01 s m against a 1-sigma of 1 m: mean NEES about 3 (consistent enough, no
+// warning); against 0.1 m: 100 times that, and the sigmas are said to understate the error.
+TEST_F(EvalCliTest, SigmasThatUnderstateTheErrorAreReported) {
+  make_files(1.0);
+  const CmdResult ok = run("--truth " + p("GINS.bin") + " --traj " + p("traj.csv") + " --json -");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const double nees = json_value(ok.out, "mean_nees_h");
+  EXPECT_NEAR(nees, 3.0, 0.05) << ok.out;
+  EXPECT_EQ(ok.err.find("understate"), std::string::npos) << ok.err;
+  fs::remove(dir_ / "GINS.bin");
+  fs::remove(dir_ / "traj.csv");
+  make_files(0.1);
+  const CmdResult bad = run("--truth " + p("GINS.bin") + " --traj " + p("traj.csv") + " --json -");
+  ASSERT_EQ(bad.code, 0) << bad.err;
+  EXPECT_NEAR(json_value(bad.out, "mean_nees_h"), 100.0 * nees, 1e-6 * nees) << bad.out;
+  EXPECT_NE(bad.err.find("1-sigma figures understate its error: mean horizontal NEES"),
+            std::string::npos)
+      << bad.err;
 }
 
 TEST_F(EvalCliTest, BadInputExitsTwo) {

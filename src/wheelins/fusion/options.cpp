@@ -63,7 +63,9 @@ std::string NavigatorOptions::describe() const {
     << "\n"
     << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
     << "filter structure:           "
-    << (fusion.centralized ? "centralized (one joint covariance)" : "distributed (paper)") << "\n"
+    << (fusion.centralized ? "centralized (one joint covariance)"
+                          : "distributed (paper; with several IMUs its 1-sigma figures are too small, "
+                            "--centralized gives consistent ones)") << "\n"
     << "innovation gates (vel/pos): " << wheel.gate << " / " << fusion.position_gate
     << " (0 = off)\n"
     << "initial sigma:              position " << wheel.init.position << " m, velocity "
