@@ -5,8 +5,10 @@
 set -euo pipefail
 build=${1:-build-asan}
 cd "$(dirname "$0")/.."
+# -O1 -g1 (line tables): the optimisation level the sanitizers' documentation suggests, and
+# a third less compile time than -O2 -g on the fixed-size joint covariances.
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_WERROR=ON \
-  -DWHEELINS_BUILD_BENCH=OFF \
+  -DWHEELINS_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
   -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
   > /dev/null
 cmake --build "$build" -j"$(nproc)"
