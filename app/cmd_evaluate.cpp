@@ -96,11 +96,8 @@ void print_table(std::ostream& os, const eval::EvalResult& r, const std::string&
                                         std::to_string(r.sigma_epochs) + " epochs)");
   else
     row("within 3 sigma (horiz.)", "n/a (no north/east std in the trajectory)");
-  if (r.has_sigma && r.mean_nees > eval::kOverconfidentNees)
-    std::fprintf(stderr,
-                 "warning: the trajectory's 1-sigma figures understate its error: mean horizontal "
-                 "NEES %.1f, 2 if consistent (the errors are about %.1fx the sigmas)\n",
-                 r.mean_nees, std::sqrt(r.mean_nees / 2.0));
+  if (const std::string w = eval::sigma_warning(r); !w.empty())
+    std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (r.aligned)
     row("alignment", "shift n/e/d " + fmt(r.align_offset.x(), 3) + " / " +
                          fmt(r.align_offset.y(), 3) + " / " + fmt(r.align_offset.z(), 3) +

@@ -168,11 +168,8 @@ int run(const RunArgs& a) {
     if (e.has_sigma)
       std::printf("  within 3 sigma      %10.1f %% of epochs (mean NEES %.2f, 2 if consistent)\n",
                   100.0 * e.within_3sigma, e.mean_nees);
-    if (e.has_sigma && e.mean_nees > eval::kOverconfidentNees)
-      std::fprintf(stderr,
-                   "warning: the trajectory's 1-sigma figures understate its error: mean horizontal NEES "
-                   "%.1f, 2 if consistent (the errors are about %.1fx the sigmas)%s\n",
-                   e.mean_nees, std::sqrt(e.mean_nees / 2.0),
+    if (const std::string w = eval::sigma_warning(e); !w.empty())
+      std::fprintf(stderr, "warning: %s%s\n", w.c_str(),
                    req.modules.size() > 1 && !req.nav.fusion.centralized
                        ? ": the distributed filter fuses the position constraint into each subsystem as "
                          "if the others' reference point were independent of it, so its covariances "

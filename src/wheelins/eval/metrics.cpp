@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <limits>
 #include <stdexcept>
@@ -391,6 +392,16 @@ class JsonObject {
 };
 
 }  // namespace
+
+std::string sigma_warning(const EvalResult& r) {
+  if (!r.has_sigma || !(r.mean_nees > kOverconfidentNees)) return {};
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "the trajectory's 1-sigma figures understate its error: mean horizontal NEES %.1f, "
+                "2 if consistent (the errors are about %.1fx the sigmas)",
+                r.mean_nees, std::sqrt(r.mean_nees / 2.0));
+  return buf;
+}
 
 std::string to_json(const EvalResult& r) {
   std::string o;

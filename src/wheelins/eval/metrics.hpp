@@ -97,6 +97,10 @@ struct EvalResult {
 /// correlated, our consistent filters measure 2.4-5.9 (docs/accuracy.md).
 constexpr double kOverconfidentNees = 10.0;
 
+/// "the trajectory's 1-sigma figures understate its error: ..." when the mean horizontal NEES
+/// is above kOverconfidentNees; empty otherwise (or without sigmas).
+std::string sigma_warning(const EvalResult& result);
+
 /// r_k = max{err[i] : s[i] <= k l} / (k l) for k = 1..floor(s.back() / l), with s
 /// non-decreasing distances from 0. Empty when s.back() < l.
 std::vector<double> drift_rate_curve(const std::vector<double>& s, const std::vector<double>& err,
