@@ -24,6 +24,7 @@ struct Args {
   std::string out;
   std::string speed = "own";
   std::string only;
+  std::string calibration = "estimate";
   int jobs = 2;
   double duration = 0.0;
   bool force = false;
@@ -44,6 +45,8 @@ int run(const Args& a) {
   spec.dataset = fs::absolute(manifest).lexically_normal();
   spec.speed = a.speed;
   spec.duration = a.duration;
+  calibration_mode_from_name(a.calibration);  // checks the name
+  spec.calibration = a.calibration;
   std::stringstream ss(a.only);
   for (std::string item; std::getline(ss, item, ',');)
     if (!item.empty()) spec.only.push_back(item);
@@ -138,6 +141,8 @@ const bool registered = cli::register_command(
       sub.add_option("--only", a->only,
                      "Subset: single,dual-wheel,body-wheel,triple,centralized (comma list)");
       sub.add_option("--duration", a->duration, "Seconds of navigation per run (default: all)");
+      sub.add_option("--calibration", a->calibration,
+                     "Wheel-IMU mounting and lever arm: estimate (default) | manifest");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line");
       sub.add_flag("--no-plots", a->no_plots,

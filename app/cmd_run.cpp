@@ -36,6 +36,7 @@ struct RunArgs {
   std::string speed;
   std::string weights;
   std::string yaw;
+  std::string calibration;
   bool centralized = false;
   bool no_constraint = false;
   bool no_faults = false;
@@ -94,6 +95,7 @@ int run(const RunArgs& a) {
     cfg.nav.fusion.weighting = weighting_from_name(a.weights);
     cfg.nav.fusion.weights.clear();  // the command line overrides the configuration's list
   }
+  if (!a.calibration.empty()) cfg.calibration = calibration_mode_from_name(a.calibration);
   if (a.centralized) cfg.nav.fusion.centralized = true;
   if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
   if (a.force) cfg.overwrite = true;
@@ -142,6 +144,7 @@ int run(const RunArgs& a) {
               static_cast<unsigned long long>(st.covariance_checks),
               static_cast<unsigned long long>(st.covariance_not_pd), st.max_covariance_asymmetry);
   if (req.nav.faults.enabled) std::cout << res.fault_report;
+  std::cout << res.calibration_report;
   std::cout << res.noise_report;
   std::cout << res.weights_report;
   for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
@@ -208,6 +211,9 @@ const bool registered = cli::register_command(
       sub.add_option("--weights", a->weights,
                      "Reference weights k_i of eq. (8): equal (paper) | covariance (each "
                      "subsystem's own uncertainty; weights.csv)");
+      sub.add_option("--calibration", a->calibration,
+                     "Wheel-IMU mounting and lever arm: estimate (default: from the data, "
+                     "calibration.yaml) | manifest (as given)");
       sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
       sub.add_flag("--no-evaluate", a->no_evaluate,

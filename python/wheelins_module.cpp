@@ -66,6 +66,7 @@ struct Settings {
   std::optional<bool> centralized, position_constraint, fault_handling, fixed_noise;
   std::optional<double> duration, output_interval, covariance_interval;
   std::string yaw_scale_factors;
+  std::string calibration;  ///< "" = the configuration's (estimate by default)
 };
 
 /// The run configuration as `wheelins run` builds it from a config file and its flags.
@@ -93,6 +94,7 @@ RunConfig run_config(const std::string& manifest, const Settings& s) {
   if (!s.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(s.speed);
   if (!s.yaw_scale_factors.empty())
     cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(s.yaw_scale_factors);
+  if (!s.calibration.empty()) cfg.calibration = calibration_mode_from_name(s.calibration);
   if (!s.weights.empty()) {
     cfg.nav.fusion.weighting = weighting_from_name(s.weights);
     cfg.nav.fusion.weights.clear();  // as wheelins run --weights: over the config's list
@@ -120,7 +122,7 @@ struct RunOutput {
   std::vector<TrajectoryRecord> records;
   std::optional<std::string> metrics_json;
   NavigatorStats stats;
-  std::string fault_report, noise_report, weights_report;
+  std::string fault_report, noise_report, weights_report, calibration_report;
   std::vector<WeightRecord> weights;  ///< the reference weights of eq. (8) over time
   std::vector<std::string> files;
   std::string manifest;
@@ -134,11 +136,11 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
               std::optional<bool> position_constraint, std::optional<bool> fault_handling, bool evaluate,
               std::optional<double> duration, std::optional<double> output_interval,
               std::optional<double> covariance_interval, const std::string& weights,
-              std::optional<bool> fixed_noise, const std::string& yaw_scale_factors, bool force,
-              bool progress) {
+              std::optional<bool> fixed_noise, const std::string& yaw_scale_factors,
+              const std::string& calibration, bool force, bool progress) {
   Settings s{configuration, text(config).value_or(""), speed, weights, chips, modules, formats,
              centralized, position_constraint, fault_handling, fixed_noise, duration, output_interval,
-             covariance_interval, yaw_scale_factors};
+             covariance_interval, yaw_scale_factors, calibration};
   RunConfig cfg = run_config(text(manifest).value_or(""), s);
   if (force) cfg.overwrite = true;
   const std::optional<std::string> out_dir = text(out);
@@ -172,6 +174,7 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
   o.stats = res.stats;
   o.fault_report = res.fault_report;
   o.noise_report = res.noise_report;
+  o.calibration_report = res.calibration_report;
   o.weights_report = res.weights_report;
   o.weights = res.weights;
   for (const auto& f : res.files) o.files.push_back(f.string());
@@ -289,7 +292,9 @@ class StreamNavigator {
                   const std::string& yaw_scale_factors) {
     Settings s{configuration, text(config).value_or(""), speed, "", chips, modules, {},
                centralized, position_constraint, fault_handling, std::nullopt, duration, output_interval,
-               covariance_interval, yaw_scale_factors};
+               covariance_interval, yaw_scale_factors, "manifest"};
+    // It sees each sample once: the manifest's geometry as it is (a calibrated manifest
+    // comes from `wheelins calibrate`).
     req_ = make_run_request(run_config(text(manifest).value_or(""), s), stderr_sink());
     req_.output_dir.clear();
     validate_run_request(req_);
@@ -448,6 +453,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("metrics_json", &RunOutput::metrics_json)
       .def_readonly("fault_report", &RunOutput::fault_report)
       .def_readonly("noise_report", &RunOutput::noise_report)
+      .def_readonly("calibration_report", &RunOutput::calibration_report)
       .def_readonly("weights_report", &RunOutput::weights_report)
       .def_property_readonly("weights_table",
                              [](const RunOutput& r) {
@@ -474,7 +480,8 @@ PYBIND11_MODULE(_core, m) {
         py::arg("position_constraint") = py::none(), py::arg("fault_handling") = py::none(), py::arg("evaluate") = true,
         py::arg("duration") = py::none(), py::arg("output_interval") = py::none(),
         py::arg("covariance_interval") = py::none(), py::arg("weights") = "", py::arg("fixed_noise") = py::none(),
-        py::arg("yaw_scale_factors") = "", py::arg("force") = false, py::arg("progress") = false);
+        py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("force") = false,
+        py::arg("progress") = false);
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
         py::arg("origin") = py::none(), py::arg("series") = false);

@@ -168,8 +168,9 @@ class GoldenRuns : public ::testing::Test {
 
   /// Navigates `configuration` of the dataset in memory; the vehicle solution at 1 Hz.
   static Table navigate(const fs::path& dataset, const std::string& configuration,
-                        bool centralized) {
+                        bool centralized, CalibrationMode calibration = CalibrationMode::kEstimate) {
     RunRequest r;
+    r.calibration = calibration;
     r.manifest = load_manifest(dataset / "manifest.yaml", {});
     r.modules = configuration_modules(r.manifest, configuration, {});
     r.nav.earth_rotation = r.manifest.earth_rotation;
@@ -214,6 +215,13 @@ TEST_F(GoldenRuns, SimulatedData) {
 
 TEST_F(GoldenRuns, SingleWheelIns) {
   check_golden("single.csv", navigate(*plain_, "single", false), tolerances());
+}
+
+// The manifest's geometry as it is (calibration: manifest): the pipeline before the
+// installation calibration, pinned on its own.
+TEST_F(GoldenRuns, SingleWheelInsManifestGeometry) {
+  check_golden("single-manifest.csv", navigate(*plain_, "single", false, CalibrationMode::kManifest),
+               tolerances());
 }
 
 TEST_F(GoldenRuns, BodyWheelIns) {

@@ -164,9 +164,10 @@ TEST_F(NavEndToEnd, RunWritesFilesAndNeverOverwritesUnasked) {
   r.progress = false;
   r.max_duration = 20.0;
   const RunResult first = run_navigation(r);
-  // csv, tum, kml, one csv per subsystem, faults.csv, noise.yaml, weights.csv
-  ASSERT_EQ(first.files.size(), 8u);
+  // csv, tum, kml, one csv per subsystem, faults.csv, noise.yaml, calibration.yaml, weights.csv
+  ASSERT_EQ(first.files.size(), 9u);
   EXPECT_TRUE(fs::exists(out / "noise.yaml"));
+  EXPECT_TRUE(fs::exists(out / "calibration.yaml"));
   EXPECT_TRUE(fs::exists(out / "weights.csv"));
   // One record per constraint epoch (1 Hz) from 1 s after the start: 19 or 20 in 20 s.
   EXPECT_GE(first.weights.size(), 19u);

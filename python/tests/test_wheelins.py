@@ -149,7 +149,8 @@ WHEEL_L, WHEEL_R, BODY = "left-wheel-imu/tri_C1_imu.bin", "right-wheel-imu/tri_C
 ])
 def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, tmp_path, configuration, files, settings,
                                                                    flags):
-    cli("run", "-m", dataset["manifest"], "-c", configuration, "-o", tmp_path, "-q", *flags)
+    # The streaming navigator takes the manifest's geometry as it is: so does this run.
+    cli("run", "-m", dataset["manifest"], "-c", configuration, "-o", tmp_path, "-q", "--calibration", "manifest", *flags)
     nav = wheelins.Navigator(dataset["manifest"], configuration=configuration, **settings)
     assert len(nav.modules) == len(files)
     # The simulated manifest has no time offsets: merge by the file times, ties in module order.
@@ -186,7 +187,8 @@ def test_streaming_navigator_applies_the_runs_input_checks(dataset, tmp_path):
     rows = load_rows(dataset, WHEEL_L).copy()
     rows[5000, 2] = 1e6  # rad/s
     rows.astype("<f8").tofile(copy / WHEEL_L)
-    p = cli("run", "-m", copy / "manifest.yaml", "-c", "body-wheel", "-o", tmp_path / "out", "-q")
+    p = cli("run", "-m", copy / "manifest.yaml", "-c", "body-wheel", "-o", tmp_path / "out", "-q",
+            "--calibration", "manifest")
     assert "beyond the sensor range" in p.stderr or "beyond the sensor range" in p.stdout
     nav = wheelins.Navigator(copy / "manifest.yaml", configuration="body-wheel")
     data = [rows, load_rows(dataset, BODY)]
@@ -196,7 +198,7 @@ def test_streaming_navigator_applies_the_runs_input_checks(dataset, tmp_path):
     same_as_csv(nav.trajectory, read_csv(tmp_path / "out" / "trajectory.csv"))
 
 
-def test_navigator_from_module_specs(dataset, cli_triple):
+def test_navigator_from_module_specs(dataset, tmp_path):
     """The manifest's content as a dict (no files named) navigates like the manifest file."""
     yaml = pytest.importorskip("yaml")  # python3-yaml, installed by scripts/setup.sh
     # Floats kept as their text: a manifest number of more than 17 digits converts to SI in
@@ -215,7 +217,8 @@ def test_navigator_from_module_specs(dataset, cli_triple):
     for _, i, k in sorted((r[k, 0], i, k) for i, r in enumerate(rows) for k in range(len(r))):
         nav.push(i, rows[i][k][0], rows[i][k][1:4], rows[i][k][4:7])
     nav.finish()
-    same_as_csv(nav.trajectory, read_csv(cli_triple[0] / "trajectory.csv"))
+    cli("run", "-m", dataset["manifest"], "-c", "triple", "-o", tmp_path, "-q", "--calibration", "manifest")
+    same_as_csv(nav.trajectory, read_csv(tmp_path / "trajectory.csv"))
     spec["modules"][0]["wheel_radius_m"] = -1
     with pytest.raises(wheelins.InputError, match=r"modules\[0\].wheel_radius_m"):
         wheelins.Navigator(spec)

@@ -76,7 +76,8 @@ class Result:
     """A run: .trajectory (dict of numpy arrays keyed by the trajectory CSV's header names,
     in its units), .metrics (the evaluation against the manifest's truth, keyed as
     `wheelins evaluate --json`; None without a truth file), .stats, .fault_report,
-    .noise_report (the noise model identified, as printed by `wheelins run`), .weights (the
+    .noise_report (the noise model identified, as printed by `wheelins run`),
+    .calibration_report (the Wheel-IMUs' estimated installation geometry), .weights (the
     reference weights of eq. (8) at every constraint epoch, as weights.csv: dict of numpy
     arrays, "t_s" and one per module; empty for a single IMU), .weights_report,
     .modules, .files (written when run(out=...))."""
@@ -88,6 +89,7 @@ class Result:
         self.stats = output.stats
         self.fault_report = output.fault_report
         self.noise_report = output.noise_report
+        self.calibration_report = output.calibration_report
         self.weights_report = output.weights_report
         w = output.weights_table
         self.weights = {} if w.shape[0] == 0 else {
@@ -112,7 +114,8 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
     `wheelins run` by name: speed="mean", centralized=True, position_constraint=False,
     fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0,
     weights="covariance" (or "equal"), fixed_noise=True, yaw_scale_factors="held" (or "auto",
-    "constraint", "estimated").
+    "constraint", "estimated"), calibration="manifest" (or "estimate", the default: the
+    Wheel-IMUs' mounting and lever arm estimated from the data first).
     """
     if isinstance(chips, str):
         chips = [c for c in chips.split(",") if c]

@@ -181,4 +181,8 @@ void InputChecks::check_static() {
                      "there, or gravity_m_s2 / the accelerometer scale is wrong");
 }
 
+CheckedStream::CheckedStream(std::unique_ptr<ImuFileReader> reader, const ModuleSpec& spec,
+                             const Manifest& m, bool isolate, const WarningSink& warn)
+    : reader_(std::move(reader)), checks_(spec, m, isolate, warn, io_detail::quote(reader_->file())) {}
+
 }  // namespace wheelins

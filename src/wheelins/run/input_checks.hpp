@@ -7,7 +7,10 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+
 #include "wheelins/io/diagnostics.hpp"
+#include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/nav/types.hpp"
 
@@ -67,6 +70,27 @@ class InputChecks {
   Vec3 sum_dtheta_ = Vec3::Zero(), sum_dvel_ = Vec3::Zero();
   double static_time_ = 0.0;
   std::uint64_t static_n_ = 0;
+};
+
+/// One module's file through the input checks: what a run (and its calibration pass) reads.
+class CheckedStream final : public ImuStream {
+ public:
+  CheckedStream(std::unique_ptr<ImuFileReader> reader, const ModuleSpec& spec, const Manifest& m,
+                bool isolate, const WarningSink& warn);
+
+  bool next(ImuSample& s) override {
+    while (reader_->next(s))
+      if (checks_.admit(s, reader_->index())) return true;
+    checks_.finish();
+    return false;
+  }
+
+  std::uint64_t dropped() const { return checks_.dropped(); }
+  const ImuFileReader& reader() const { return *reader_; }
+
+ private:
+  std::unique_ptr<ImuFileReader> reader_;
+  InputChecks checks_;
 };
 
 }  // namespace wheelins

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <set>
 
 #include "wheelins/run/input_checks.hpp"
@@ -44,28 +45,6 @@ std::string fmt(double v, const char* f = "%.4g") {
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
 }
-
-/// One module's file through the input checks (run/input_checks.hpp).
-class CheckedStream final : public ImuStream {
- public:
-  CheckedStream(std::unique_ptr<ImuFileReader> reader, const ModuleSpec& spec, const Manifest& m,
-                bool isolate, const WarningSink& warn)
-      : reader_(std::move(reader)), checks_(spec, m, isolate, warn, quote(reader_->file())) {}
-
-  bool next(ImuSample& s) override {
-    while (reader_->next(s))
-      if (checks_.admit(s, reader_->index())) return true;
-    checks_.finish();
-    return false;
-  }
-
-  std::uint64_t dropped() const { return checks_.dropped(); }
-  const ImuFileReader& reader() const { return *reader_; }
-
- private:
-  std::unique_ptr<ImuFileReader> reader_;
-  InputChecks checks_;
-};
 
 bool finite(const TrajectoryRecord& r) {
   return std::isfinite(r.t) && r.p_inN.allFinite() && r.v_inN.allFinite() && r.rpy.allFinite() &&
@@ -128,6 +107,7 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
     for (const auto& m : r.modules) files.push_back(r.output_dir / (m + ".csv"));
   files.push_back(r.output_dir / "faults.csv");
   files.push_back(r.output_dir / "noise.yaml");
+  if (r.calibration == CalibrationMode::kEstimate) files.push_back(r.output_dir / "calibration.yaml");
   if (writes_weights(r)) files.push_back(r.output_dir / "weights.csv");
   return files;
 }
@@ -149,6 +129,15 @@ RunResult run_navigation(const RunRequest& r) {
     out_dir = std::make_unique<OutputDir>(r.output_dir, o);
   }
   auto staged = [&](const fs::path& final_file) { return out_dir->staging() / final_file.filename(); };
+
+  // The installation calibration pass: the Wheel-IMUs' files read once before navigating.
+  std::vector<WheelImuCalibration> calibration;
+  if (r.calibration == CalibrationMode::kEstimate)
+    calibration = calibrate_installation(r.manifest, r.modules, r.calibration_options,
+                                         r.nav.faults.enabled, r.progress,
+                                         r.max_duration > 0.0 ? r.manifest.static_end + r.max_duration
+                                                              : std::numeric_limits<double>::infinity());
+  const Manifest manifest = apply_calibration(r.manifest, calibration);
 
   // Readers for the selected modules only, merged by time; each through the input checks.
   std::vector<std::unique_ptr<ImuStream>> readers;
@@ -200,7 +189,7 @@ RunResult run_navigation(const RunRequest& r) {
   double sink_seconds = 0.0;
   int bad_stream = -1;
   double bad_t = 0.0;
-  Navigator nav(r.manifest, r.modules, nav_opt, [&](int stream, const TrajectoryRecord& rec) {
+  Navigator nav(manifest, r.modules, nav_opt, [&](int stream, const TrajectoryRecord& rec) {
     if (bad_stream >= 0) return;
     if (!finite(rec)) {
       bad_stream = stream;
@@ -299,6 +288,11 @@ RunResult run_navigation(const RunRequest& r) {
     AtomicTextFile noise(staged(r.output_dir / "noise.yaml"), false);
     noise.write(noise_report_yaml(result.noise, r.manifest, r.nav.noise.enabled));
     noise.commit();
+    if (r.calibration == CalibrationMode::kEstimate) {
+      AtomicTextFile cal(staged(r.output_dir / "calibration.yaml"), false);
+      cal.write(calibration_yaml(calibration, r.manifest));
+      cal.commit();
+    }
     if (writes_weights(r)) {
       AtomicTextFile weights(staged(r.output_dir / "weights.csv"), false);
       weights.write(weights_csv(nav.weight_history(), r.modules));
@@ -306,6 +300,8 @@ RunResult run_navigation(const RunRequest& r) {
     }
     out_dir->commit();  // every file appears at once
   }
+  if (r.calibration == CalibrationMode::kEstimate) result.calibration_report = calibration_report(calibration);
+  result.calibration = std::move(calibration);
   result.weights = nav.weight_history();
   result.weights_report = weights_report(result.weights, r.modules, r.nav.fusion);
   result.fault_report = fault_report_text(nav.faults());

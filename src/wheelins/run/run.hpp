@@ -11,6 +11,7 @@
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/io/trajectory.hpp"
+#include "wheelins/run/calibration.hpp"
 
 namespace wheelins {
 
@@ -25,6 +26,10 @@ struct RunRequest {
   bool write_subsystems = true;      ///< also <module>.csv per subsystem (multi-IMU runs)
   bool progress = true;              ///< a progress line on a terminal
   double max_duration = 0.0;         ///< stop after this much navigation [s]; 0 = all data
+  /// The Wheel-IMUs' mounting and lever arm: estimated from the data in a first pass over
+  /// their files (calibration.yaml beside the trajectory), or the manifest's.
+  CalibrationMode calibration = CalibrationMode::kEstimate;
+  InstallationCalibrationOptions calibration_options;
   WarningSink warn;
   /// Called for every vehicle record (e.g. to evaluate in memory); may be empty.
   std::function<void(const TrajectoryRecord&)> on_record;
@@ -41,6 +46,8 @@ struct RunResult {
   std::string noise_report;                  ///< readable summary of it, with the warnings
   std::vector<WeightRecord> weights;         ///< the reference weights of eq. (8) over time (weights.csv)
   std::string weights_report;                ///< readable summary of them (multi-IMU runs)
+  std::vector<WheelImuCalibration> calibration;  ///< the installation estimates (calibration.yaml)
+  std::string calibration_report;            ///< readable table of them (empty: not estimated)
 };
 
 /// Runs the request. The output directory is written through OutputDir: checked, locked

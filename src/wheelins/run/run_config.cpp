@@ -40,6 +40,12 @@ YawScaleFactorChoice yaw_scale_factors_from_name(const std::string& name) {
   throw InputError("yaw scale factors '" + name + "': expected auto, held, constraint or estimated");
 }
 
+CalibrationMode calibration_mode_from_name(const std::string& name) {
+  if (name == "estimate") return CalibrationMode::kEstimate;
+  if (name == "manifest") return CalibrationMode::kManifest;
+  throw InputError("calibration '" + name + "': expected estimate or manifest");
+}
+
 ReferenceWeighting weighting_from_name(const std::string& name) {
   if (name == "equal") return ReferenceWeighting::kFixed;
   if (name == "covariance") return ReferenceWeighting::kCovariance;
@@ -50,7 +56,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   const YamlReader y(file, warn, "run configuration");
   const YAML::Node& root = y.root();
   y.check_keys(root, "", {"dataset", "configuration", "chips", "modules", "output", "duration_s",
-                          "filter", "fusion", "faults", "noise"});
+                          "calibration", "filter", "fusion", "faults", "noise"});
   RunConfig c;
   const fs::path base = file.parent_path();
   auto rel = [&](const std::string& p) { return fs::path(p).is_absolute() ? fs::path(p) : base / p; };
@@ -67,6 +73,10 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     c.max_duration = y.number_in(v, "duration_s", kRange.duration[0], kRange.duration[1], "s");
     if (c.max_duration <= 0) y.fail("duration_s", "must be > 0 s (leave it out for all the data)", &v);
   }
+
+  if (auto v = y.get(root, "calibration"); v.IsDefined())
+    c.calibration = y.choice<CalibrationMode>(
+        v, "calibration", {{"estimate", CalibrationMode::kEstimate}, {"manifest", CalibrationMode::kManifest}});
 
   if (auto out = y.get(root, "output"); out.IsDefined()) {
     y.require_map(out, "output");
@@ -303,6 +313,7 @@ RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn) {
   r.overwrite = cfg.overwrite;
   r.write_subsystems = cfg.write_subsystems;
   r.max_duration = cfg.max_duration;
+  r.calibration = cfg.calibration;
   r.warn = warn;
   return r;
 }

@@ -23,6 +23,8 @@ struct RunConfig {
   bool write_subsystems = true;
   double max_duration = 0.0;
   std::string earth_rotation = "auto";     ///< auto (from the manifest) | true | false
+  /// The Wheel-IMUs' installation: estimated from the data (default) or the manifest's.
+  CalibrationMode calibration = CalibrationMode::kEstimate;
   NavigatorOptions nav;
 };
 
@@ -32,6 +34,8 @@ RunConfig load_run_config(const std::filesystem::path& file, const WarningSink& 
 SpeedSharing speed_sharing_from_name(const std::string& name);
 /// `auto`, `held`, `constraint` or `estimated` (docs/filter.md 13.4); InputError otherwise.
 YawScaleFactorChoice yaw_scale_factors_from_name(const std::string& name);
+/// `estimate` or `manifest` (run/calibration.hpp); InputError otherwise.
+CalibrationMode calibration_mode_from_name(const std::string& name);
 /// `equal` (the paper) or `covariance` (reference_weights.hpp); InputError otherwise.
 ReferenceWeighting weighting_from_name(const std::string& name);
 

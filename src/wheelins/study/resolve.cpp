@@ -208,6 +208,8 @@ Job Study::job(std::size_t k) const {
           {"run.duration_s", YAML::Node(io_detail::format_double(experiment_->duration)), w});
     settings.push_back({"modules", modules, w});
     settings.push_back({"run.fusion.centralized", YAML::Node(r.centralized), w});
+    if (experiment_->calibration != "estimate")
+      settings.push_back({"run.calibration", YAML::Node(experiment_->calibration), w});
     Job j = resolve(k, choice, settings);
     j.keep_series = r.figure;
     j.experiment_run = r;

@@ -356,6 +356,7 @@ std::string experiment_study_yaml(const ExperimentSpec& e) {
   }
   s += "  speed: " + e.speed + "\n";
   if (e.duration > 0) s += "  duration_s: " + io_detail::format_double(e.duration) + "\n";
+  if (e.calibration != "estimate") s += "  calibration: " + e.calibration + "\n";
   return s;
 }
 
@@ -432,7 +433,7 @@ Study Study::load(const fs::path& file, const LoadOptions& options) {
       if (YamlReader::get(root, k).IsDefined())
         y.fail(k, "not with `experiment` (the built-in study fixes its runs)", &e);
     y.require_map(e, "experiment");
-    y.check_keys(e, "experiment", {"dataset", "only", "speed", "duration_s"});
+    y.check_keys(e, "experiment", {"dataset", "only", "speed", "duration_s", "calibration"});
     ExperimentSpec x;
     x.dataset = rel(y.text(y.required(e, "experiment", "dataset"), "experiment.dataset"));
     if (fs::is_directory(x.dataset)) x.dataset /= "manifest.yaml";
@@ -447,6 +448,9 @@ Study Study::load(const fs::path& file, const LoadOptions& options) {
                &e);
     if (auto v = YamlReader::get(e, "speed"); v.IsDefined())
       x.speed = y.choice<std::string>(v, "experiment.speed", {{"mean", "mean"}, {"own", "own"}});
+    if (auto v = YamlReader::get(e, "calibration"); v.IsDefined())
+      x.calibration = y.choice<std::string>(v, "experiment.calibration",
+                                            {{"estimate", "estimate"}, {"manifest", "manifest"}});
     if (auto v = YamlReader::get(e, "duration_s"); v.IsDefined()) {
       x.duration = y.number(v, "experiment.duration_s");
       if (x.duration < 0) y.fail("experiment.duration_s", "must be >= 0 (0: all data)", &v);

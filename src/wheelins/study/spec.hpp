@@ -97,6 +97,7 @@ struct ExperimentSpec {
   std::vector<std::string> only;
   std::string speed = "own";  ///< the run default (FusionOptions::speed)
   double duration = 0.0;
+  std::string calibration = "estimate";  ///< the run default (RunConfig::calibration)
 };
 
 struct LoadOptions {

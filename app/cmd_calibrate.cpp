@@ -1,0 +1,120 @@
+// `wheelins calibrate`: refines a manifest's Wheel-IMU installation geometry (the axle
+// direction and the lever arm) from a recording, and writes the refined manifest and the
+// estimates with their 1 sigma (docs/filter.md section 15).
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "cli.hpp"
+#include "wheelins/io/atomic_file.hpp"
+#include "wheelins/run/calibration.hpp"
+
+namespace {
+using namespace wheelins;
+namespace fs = std::filesystem;
+
+struct Options {
+  std::string manifest;
+  std::string modules;
+  std::string out;
+  std::string report;
+  std::optional<double> duration;
+  bool no_faults = false;
+  bool force = false;
+  bool quiet = false;
+};
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+bool same_file(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+}
+
+int run(const Options& o) {
+  if (o.duration && (!std::isfinite(*o.duration) || *o.duration <= 0.0))
+    throw InputError("--duration " + std::to_string(*o.duration) + ": must be a positive number of seconds");
+  const fs::path in = fs::path(o.manifest).filename().empty() || fs::is_directory(o.manifest)
+                          ? fs::path(o.manifest) / "manifest.yaml"
+                          : fs::path(o.manifest);
+  const fs::path out(o.out);
+  const fs::path report = o.report.empty() ? fs::path(out).replace_extension(".calibration.yaml")
+                                           : fs::path(o.report);
+  // The input manifest is never overwritten, --force or not.
+  if (same_file(in, out) || same_file(in, report))
+    throw InputError("'" + out.string() + "' is the input manifest '" + in.string() +
+                     "': write the refined manifest to another file");
+  if (out == report) throw InputError("--out and --report name the same file '" + out.string() + "'");
+  check_output_target(out, o.force);
+  check_output_target(report, o.force);
+
+  const Manifest m = load_manifest(in);
+  std::vector<std::string> modules = split_list(o.modules);
+  if (modules.empty()) {
+    for (const auto& s : m.modules)
+      if (s.kind == ModuleKind::kWheel) modules.push_back(s.name);
+  } else {
+    for (const auto& name : modules) {
+      const ModuleSpec* s = m.find(name);
+      if (!s) throw InputError("--modules: '" + in.string() + "' has no module '" + name + "'");
+      if (s->kind != ModuleKind::kWheel)
+        throw InputError("--modules: '" + name + "' is a Body-IMU; only Wheel-IMUs are calibrated");
+    }
+  }
+  if (modules.empty()) throw InputError("'" + in.string() + "' has no Wheel-IMU module to calibrate");
+
+  const double t_end = o.duration ? m.static_end + *o.duration : std::numeric_limits<double>::infinity();
+  const auto cal = calibrate_installation(m, modules, InstallationCalibrationOptions{}, !o.no_faults,
+                                          !o.quiet, t_end);
+  std::cout << calibration_report(cal);
+  int unobserved = 0;
+  for (const auto& c : cal)
+    if (!c.axle_tilt_y.observed || !c.axle_tilt_z.observed || !c.lever_arm[1].observed ||
+        !c.lever_arm[2].observed)
+      ++unobserved;
+  // Both files written in full before either is moved into place.
+  for (const fs::path& f : {out, report})
+    if (f.has_parent_path()) fs::create_directories(f.parent_path());
+  AtomicTextFile refined(out, o.force), estimates(report, o.force);
+  refined.write(manifest_to_yaml(apply_calibration(m, cal), out.has_parent_path() ? out.parent_path() : fs::path(".")));
+  estimates.write(calibration_yaml(cal, m));
+  refined.commit();
+  estimates.commit();
+  std::cout << "wrote " << out.string() << "\nwrote " << report.string() << "\n";
+  if (unobserved > 0)
+    std::cerr << "warning: " << unobserved << " of " << cal.size()
+              << " modules have parts the recording does not determine (observed: false in '"
+              << report.string() << "'); those keep the manifest's values\n";
+  return 0;
+}
+
+const bool registered = cli::register_command(
+    28, "calibrate",
+    "Refine a manifest's Wheel-IMU mounting and lever arm from its recording", [](CLI::App& sub) {
+      auto o = std::make_shared<Options>();
+      sub.add_option("-m,--manifest", o->manifest, "dataset directory (with manifest.yaml) or manifest file")
+          ->required();
+      sub.add_option("--out,-o", o->out, "refined manifest to write (never the input manifest)")->required();
+      sub.add_option("--report", o->report,
+                     "the estimates with 1 sigma (default: OUT with extension .calibration.yaml)");
+      sub.add_option("--modules", o->modules, "Wheel-IMU modules to calibrate (default: all)");
+      sub.add_option("--duration", o->duration, "seconds of the recording after the static period to use");
+      sub.add_flag("--no-faults", o->no_faults, "no fault isolation of the input samples");
+      sub.add_flag("--force,-f", o->force, "overwrite existing output files");
+      sub.add_flag("--quiet,-q", o->quiet, "no progress line");
+      return [o]() { return run(*o); };
+    });
+
+}  // namespace
