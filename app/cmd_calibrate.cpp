@@ -1,5 +1,5 @@
-// `wheelins calibrate`: refines a manifest's Wheel-IMU installation geometry (the axle
-// direction and the lever arm) from a recording, and writes the refined manifest and the
+// `wheelins calibrate`: refines a manifest's installation geometry (each Wheel-IMU's axle
+// direction, lever arm and relative radius, each Body-IMU's mounting) from a recording, and writes the refined manifest and the
 // estimates with their 1 sigma (docs/filter.md section 15).
 #include <cmath>
 #include <filesystem>
@@ -63,27 +63,23 @@ int run(const Options& o) {
   const Manifest m = load_manifest(in);
   std::vector<std::string> modules = split_list(o.modules);
   if (modules.empty()) {
-    for (const auto& s : m.modules)
-      if (s.kind == ModuleKind::kWheel) modules.push_back(s.name);
+    for (const auto& s : m.modules) modules.push_back(s.name);
   } else {
-    for (const auto& name : modules) {
-      const ModuleSpec* s = m.find(name);
-      if (!s) throw InputError("--modules: '" + in.string() + "' has no module '" + name + "'");
-      if (s->kind != ModuleKind::kWheel)
-        throw InputError("--modules: '" + name + "' is a Body-IMU; only Wheel-IMUs are calibrated");
-    }
+    for (const auto& name : modules)
+      if (!m.find(name)) throw InputError("--modules: '" + in.string() + "' has no module '" + name + "'");
   }
-  if (modules.empty()) throw InputError("'" + in.string() + "' has no Wheel-IMU module to calibrate");
 
   const double t_end = o.duration ? m.static_end + *o.duration : std::numeric_limits<double>::infinity();
   const auto cal = calibrate_installation(m, modules, InstallationCalibrationOptions{}, !o.no_faults,
                                           !o.quiet, t_end);
   std::cout << calibration_report(cal);
-  int unobserved = 0;
-  for (const auto& c : cal)
+  std::size_t unobserved = 0;
+  for (const auto& c : cal.wheels)
     if (!c.axle_tilt_y.observed || !c.axle_tilt_z.observed || !c.lever_arm[1].observed ||
-        !c.lever_arm[2].observed)
+        !c.lever_arm[2].observed || !c.wheel_radius.observed)
       ++unobserved;
+  for (const auto& c : cal.bodies)
+    if (!c.tilt_x.observed || !c.tilt_y.observed) ++unobserved;
   // Both files written in full before either is moved into place.
   for (const fs::path& f : {out, report})
     if (f.has_parent_path()) fs::create_directories(f.parent_path());
@@ -94,7 +90,7 @@ int run(const Options& o) {
   estimates.commit();
   std::cout << "wrote " << out.string() << "\nwrote " << report.string() << "\n";
   if (unobserved > 0)
-    std::cerr << "warning: " << unobserved << " of " << cal.size()
+    std::cerr << "warning: " << unobserved << " of " << cal.wheels.size() + cal.bodies.size()
               << " modules have parts the recording does not determine (observed: false in '"
               << report.string() << "'); those keep the manifest's values\n";
   return 0;
@@ -102,14 +98,14 @@ int run(const Options& o) {
 
 const bool registered = cli::register_command(
     28, "calibrate",
-    "Refine a manifest's Wheel-IMU mounting and lever arm from its recording", [](CLI::App& sub) {
+    "Refine a manifest's installation geometry (mountings, lever arms, radii) from its recording", [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
       sub.add_option("-m,--manifest", o->manifest, "dataset directory (with manifest.yaml) or manifest file")
           ->required();
       sub.add_option("--out,-o", o->out, "refined manifest to write (never the input manifest)")->required();
       sub.add_option("--report", o->report,
                      "the estimates with 1 sigma (default: OUT with extension .calibration.yaml)");
-      sub.add_option("--modules", o->modules, "Wheel-IMU modules to calibrate (default: all)");
+      sub.add_option("--modules", o->modules, "modules to calibrate (default: all)");
       sub.add_option("--duration", o->duration, "seconds of the recording after the static period to use");
       sub.add_flag("--no-faults", o->no_faults, "no fault isolation of the input samples");
       sub.add_flag("--force,-f", o->force, "overwrite existing output files");

@@ -142,7 +142,7 @@ const bool registered = cli::register_command(
                      "Subset: single,dual-wheel,body-wheel,triple,centralized (comma list)");
       sub.add_option("--duration", a->duration, "Seconds of navigation per run (default: all)");
       sub.add_option("--calibration", a->calibration,
-                     "Wheel-IMU mounting and lever arm: estimate (default) | manifest");
+                     "installation geometry: estimate (default: from the data) | manifest (as given)");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line");
       sub.add_flag("--no-plots", a->no_plots,

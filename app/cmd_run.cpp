@@ -212,7 +212,7 @@ const bool registered = cli::register_command(
                      "Reference weights k_i of eq. (8): equal (paper) | covariance (each "
                      "subsystem's own uncertainty; weights.csv)");
       sub.add_option("--calibration", a->calibration,
-                     "Wheel-IMU mounting and lever arm: estimate (default: from the data, "
+                     "installation geometry: estimate (default: from the data, "
                      "calibration.yaml) | manifest (as given)");
       sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+
 namespace wheelins {
 
 namespace {
@@ -35,27 +37,45 @@ CalibratedValue with_prior(double prior, double prior_std, double data, double d
 }  // namespace
 
 WheelImuCalibrator::WheelImuCalibrator(const ImuModule& module, double static_start,
-                                       double static_end, const InstallationCalibrationOptions& opt)
+                                       double static_end, const InstallationCalibrationOptions& opt,
+                                       double expected_end)
     : module_(module),
       opt_(opt),
       C_StoB_(dcm_from_euler(module.mounting_rpy)),
-      static_start_(static_start),
-      static_end_(static_end) {}
+      static_{static_start, static_end} {
+  const double span = expected_end - static_end;
+  if (std::isfinite(span) && span > 0.0 && opt_.rate_bin_s > 0.0)
+    bins_.reserve(static_cast<std::size_t>(std::min(span / opt_.rate_bin_s, 1e8)) + 2);
+}
 
 void WheelImuCalibrator::add(const ImuSample& s) {
   if (!(s.dt > 0.0)) return;
   t_ = s.t;
-  if (s.t <= static_end_) {
-    if (s.t > static_start_) {
-      static_sum_ += s.dtheta;
-      static_dt_ += s.dt;
-    }
-    return;
-  }
-  const Vec3 bias = static_dt_ > 0.0 ? Vec3(static_sum_ / static_dt_) : Vec3::Zero();
+  if (static_.take(s)) return;
+  const Vec3 bias = static_.gyro_bias();
   const Vec3 w = C_StoB_ * (s.dtheta / s.dt - bias);
   const Vec3 f = C_StoB_ * (s.dvel / s.dt);
   const double wx = w.x();
+  wheel_angle_ = std::fmod(wheel_angle_ + wx * s.dt, kTurn);
+  if (s.dt <= kMaxGap && opt_.rate_bin_s > 0.0) {
+    // The rate series (RateBin::yaw_rate()).
+    const double k = std::floor((s.t - 0.5 * s.dt - static_.end) / opt_.rate_bin_s);
+    if (k >= 0.0 && k < 1e8) {
+      const auto i = static_cast<std::size_t>(k);
+      if (i >= bins_.size()) bins_.resize(i + 1);
+      RateBin& b = bins_[i];
+      b.dt += s.dt;
+      b.spin += -module_.axle_sign * wx * s.dt;
+      b.wf += (w.y() * f.y() + w.z() * f.z()) * s.dt;
+      b.w_y += w.y() * s.dt;
+      b.w_z += w.z() * s.dt;
+      b.f_y += f.y() * s.dt;
+      b.f_z += f.z() * s.dt;
+      const double a_mid = wheel_angle_ + 0.5 * wx * s.dt;
+      b.cos_a += std::cos(a_mid) * s.dt;
+      b.sin_a += std::sin(a_mid) * s.dt;
+    }
+  }
   const double alpha = have_prev_ ? (wx - prev_wx_) / s.dt : 0.0;
   prev_wx_ = wx;
   have_prev_ = true;
@@ -159,7 +179,7 @@ WheelImuCalibration WheelImuCalibrator::result() const {
     const Vec3 mean = dir_sum_ / n;
     const double vy = std::max(0.0, (dir_sq_(1, 1) / n - mean.y() * mean.y()) * n / (n - 1.0));
     const double vz = std::max(0.0, (dir_sq_(2, 2) / n - mean.z() * mean.z()) * n / (n - 1.0));
-    const double arw_static = static_dt_ > 0.0 ? module_.noise.gyro_arw / std::sqrt(static_dt_) : 0.0;
+    const double arw_static = static_.gyro_bias_noise(module_.noise.gyro_arw);
     const double bias_term = std::hypot(module_.noise.gyro_bias_std, arw_static) * rolling_time_ / spin_angle_;
     sy = std::sqrt(vz / n + bias_term * bias_term);  // delta_y is a_z
     sz = std::sqrt(vy / n + bias_term * bias_term);
@@ -205,7 +225,188 @@ WheelImuCalibration WheelImuCalibrator::result() const {
   r.lever_arm[0] = CalibratedValue{prior.x(), opt_.lever_arm_prior_std, false};
   r.lever_arm[1] = with_prior(prior.y(), opt_.lever_arm_prior_std, ly, sl, opt_.observed_ratio);
   r.lever_arm[2] = with_prior(prior.z(), opt_.lever_arm_prior_std, lz, sl, opt_.observed_ratio);
+  r.manifest_wheel_radius = module_.wheel_radius;
+  r.wheel_radius = CalibratedValue{module_.wheel_radius, opt_.radius_prior_std * module_.wheel_radius, false};
   return r;
+}
+
+BodyImuCalibrator::BodyImuCalibrator(const ImuModule& module, double static_start, double static_end,
+                                     const InstallationCalibrationOptions& opt)
+    : module_(module),
+      opt_(opt),
+      C_BtoV_(dcm_from_euler(module.mounting_rpy)),
+      static_{static_start, static_end} {}
+
+void BodyImuCalibrator::add(const ImuSample& s) {
+  if (!(s.dt > 0.0)) return;
+  t_ = s.t;
+  if (static_.take(s)) return;
+  if (s.dt > kMaxGap) return;
+  if (chunk_start_ < 0.0) chunk_start_ = s.t;
+  const Vec3 bias = static_.gyro_bias();
+  const Vec3 w = C_BtoV_ * (s.dtheta / s.dt - bias);
+  const double wz = std::abs(w.z());
+  if (wz > opt_.min_yaw_rate) {
+    turn_chunk_ += w * w.transpose() * s.dt;
+    turn_chunk_time_ += s.dt;
+    yaw_sum_ += w.z() * s.dt;
+  }
+  if (s.t - chunk_start_ >= opt_.chunk_s) close_chunk();
+}
+
+namespace {
+
+/// The principal axis of a rate scatter matrix, with a positive z.
+Vec3 principal_axis(const Mat3& M) {
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(M);
+  Vec3 a = es.eigenvectors().col(2);  // eigenvalues ascending
+  return a.z() < 0.0 ? Vec3(-a) : a;
+}
+
+}  // namespace
+
+void BodyImuCalibrator::close_chunk() {
+  if (turn_chunk_time_ > 2.0) {
+    const Vec3 a = principal_axis(turn_chunk_);
+    axis_sum_ += a;
+    axis_sq_ += a.cwiseProduct(a);
+    ++axis_chunks_;
+  }
+  turn_all_ += turn_chunk_;
+  turn_time_ += turn_chunk_time_;
+  turn_chunk_ = Mat3::Zero();
+  turn_chunk_time_ = 0.0;
+  chunk_start_ = t_;
+}
+
+BodyImuCalibration BodyImuCalibrator::result() const {
+  BodyImuCalibration r;
+  r.module = module_.name;
+  r.manifest_mounting_rpy = module_.mounting_rpy;
+  const double inf = std::numeric_limits<double>::infinity();
+  // The open chunk counts in the estimates (not in their scatter).
+  const Mat3 M = turn_all_ + turn_chunk_;
+  r.turning_time = turn_time_ + turn_chunk_time_;
+  double ex = 0.0, ey = 0.0, sx = inf, sy = inf;
+  if (axis_chunks_ >= 3 && M(2, 2) > 0.0) {
+    const Vec3 a = principal_axis(M);
+    ex = a.x();
+    ey = a.y();
+    const double n = axis_chunks_;
+    const Vec3 mean = axis_sum_ / n;
+    const double vx = std::max(0.0, (axis_sq_.x() / n - mean.x() * mean.x()) * n / (n - 1.0));
+    const double vy = std::max(0.0, (axis_sq_.y() / n - mean.y() * mean.y()) * n / (n - 1.0));
+    // A residual gyro bias b adds b_x * sum(w_z dt) to M_xz.
+    const double arw_static = static_.gyro_bias_noise(module_.noise.gyro_arw);
+    const double bias_term =
+        std::hypot(module_.noise.gyro_bias_std, arw_static) * std::abs(yaw_sum_) / M(2, 2);
+    sx = std::sqrt(vx / n + bias_term * bias_term);
+    sy = std::sqrt(vy / n + bias_term * bias_term);
+  }
+  // The rotation that carries the turn axis a onto v z: phi_x = a_y, phi_y = -a_x.
+  r.tilt_x = with_prior(0.0, opt_.body_mounting_prior_std, ey, sy, opt_.observed_ratio);
+  r.tilt_y = with_prior(0.0, opt_.body_mounting_prior_std, -ex, sx, opt_.observed_ratio);
+
+  const Mat3 R = dcm_from_rotvec(Vec3(r.tilt_x.value, r.tilt_y.value, 0.0));
+  r.mounting_rpy = euler_from_dcm(R * C_BtoV_);
+  return r;
+}
+
+void estimate_relative_radius(const std::vector<const WheelImuCalibrator*>& cals,
+                              const InstallationCalibrationOptions& opt,
+                              std::vector<WheelImuCalibration>& results) {
+  const std::size_t n_mod = cals.size();
+  if (n_mod < 2 || results.size() != n_mod || !(opt.rate_bin_s > 0.0)) return;
+  double ymin = std::numeric_limits<double>::infinity(), ymax = -ymin;
+  for (const auto* c : cals) {
+    ymin = std::min(ymin, c->module().p_inV.y());
+    ymax = std::max(ymax, c->module().p_inV.y());
+  }
+  if (!(ymax - ymin > 0.05)) return;  // one side only (e.g. the chips of one wheel)
+  const double mid = 0.5 * (ymin + ymax);
+  std::vector<int> side(n_mod);
+  double y_side[2] = {0.0, 0.0};
+  int n_side[2] = {0, 0};
+  std::size_t bins = std::numeric_limits<std::size_t>::max();
+  for (std::size_t i = 0; i < n_mod; ++i) {
+    side[i] = cals[i]->module().p_inV.y() < mid ? 0 : 1;  // 0: left (v-frame y is right)
+    y_side[side[i]] += cals[i]->module().p_inV.y();
+    ++n_side[side[i]];
+    bins = std::min(bins, cals[i]->rate_bins().size());
+  }
+  y_side[0] /= n_side[0];
+  y_side[1] /= n_side[1];
+
+  // Per module i, against the other side's mean speed, the fit
+  //   y = track psi_dot - (v_L - v_R) = g_i v_mean + kappa_i track psi_dot,
+  // with g_i = eps_i - mean eps(right) for a left module, mean eps(left) - eps_i for a
+  // right one (eps: a radius's relative error, the gyro's x scale factor included: the
+  // speed the filter is given is r w_x). psi_dot: the mean yaw rate of every module.
+  struct Fit {
+    double S11 = 0, S12 = 0, S22 = 0, b1 = 0, b2 = 0, Syy = 0;
+    int n = 0;
+  };
+  std::vector<Fit> fit(n_mod);
+  std::vector<double> v(n_mod);
+  std::vector<char> ok(n_mod);
+  for (std::size_t k = 0; k < bins; ++k) {
+    double v_side[2] = {0, 0}, yaw = 0;
+    int m[2] = {0, 0};
+    for (std::size_t i = 0; i < n_mod; ++i) {
+      const RateBin& b = cals[i]->rate_bins()[k];
+      ok[i] = 0;
+      if (b.dt < 0.9 * opt.rate_bin_s) continue;  // a gap, or the last bin
+      const double rate = b.yaw_rate(cals[i]->gravity());
+      if (!std::isfinite(rate)) continue;  // too slow for a yaw rate
+      v[i] = cals[i]->module().wheel_radius * b.spin / b.dt;
+      v_side[side[i]] += v[i];
+      yaw += rate;
+      ++m[side[i]];
+      ok[i] = 1;
+    }
+    if (m[0] == 0 || m[1] == 0) continue;
+    const double psi_dot = yaw / (m[0] + m[1]);
+    for (std::size_t i = 0; i < n_mod; ++i) {
+      if (!ok[i]) continue;
+      const int o = 1 - side[i];
+      const double v_other = v_side[o] / m[o];
+      const double vl = side[i] == 0 ? v[i] : v_other, vr = side[i] == 0 ? v_other : v[i];
+      const double track = std::abs(cals[i]->module().p_inV.y() - y_side[o]);
+      const double x1 = 0.5 * (vl + vr), x2 = track * psi_dot, y = x2 - (vl - vr);
+      Fit& f = fit[i];
+      f.S11 += x1 * x1;
+      f.S12 += x1 * x2;
+      f.S22 += x2 * x2;
+      f.b1 += x1 * y;
+      f.b2 += x2 * y;
+      f.Syy += y * y;
+      ++f.n;
+    }
+  }
+  std::vector<double> g(n_mod, 0.0), sg(n_mod, std::numeric_limits<double>::infinity());
+  double D = 0.0, var_D = 0.0;
+  for (std::size_t i = 0; i < n_mod; ++i) {
+    const Fit& f = fit[i];
+    const double det = f.S11 * f.S22 - f.S12 * f.S12;
+    if (f.n <= 30 || !(det > 1e-12 * f.S11 * f.S22)) return;  // too little rolling: not observed
+    g[i] = (f.S22 * f.b1 - f.S12 * f.b2) / det;
+    const double kappa = (f.S11 * f.b2 - f.S12 * f.b1) / det;
+    const double s2 = std::max(0.0, f.Syy - g[i] * f.b1 - kappa * f.b2) / (f.n - 2);
+    sg[i] = std::sqrt(s2 * f.S22 / det);
+    D += g[i];
+    var_D += sg[i] * sg[i];
+  }
+  // D = mean eps(left) - mean eps(right), from every module's fit; each radius is corrected
+  // by its share about the two sides' mean: eps_i - (mean eps(left) + mean eps(right)) / 2.
+  D /= static_cast<double>(n_mod);
+  var_D /= static_cast<double>(n_mod * n_mod);
+  for (std::size_t i = 0; i < n_mod; ++i) {
+    const double c = side[i] == 0 ? g[i] - 0.5 * D : -g[i] + 0.5 * D;
+    const double sc = std::sqrt(sg[i] * sg[i] + 0.25 * var_D);
+    const CalibratedValue rel = with_prior(0.0, opt.radius_prior_std, c, sc, opt.observed_ratio);
+    const double m0 = cals[i]->module().wheel_radius;
+    results[i].wheel_radius = CalibratedValue{m0 * (1.0 + rel.value), m0 * rel.std, rel.observed};
+  }
 }
 
 }  // namespace wheelins

@@ -17,13 +17,26 @@
 //    regressors centred within the chunk), so a drifting bias does not leak into l; l is
 //    observable where the wheel speed varies within chunks (stops, corners). l_x (along
 //    the axle) gives no term: unobservable and without effect on the wheel velocity.
+//  * Relative wheel radii (two Wheel-IMUs on either side of the vehicle): over time bins
+//    of `rate_bin_s`, the vehicle yaw rate that the wheels themselves see (each
+//    Wheel-IMU's in-plane rate projected on the down direction its accelerometer shows,
+//    psi_dot = -(w_y f_y + w_z f_z) / g: gravity turns with the wheel exactly as the yaw
+//    rate does, so the product does not) against the wheels' speed difference,
+//      track psi_dot = r_L w_L - r_R w_R,
+//    fitted for eps_L - eps_R (the radii's relative errors) and a scale of psi_dot.
+//    estimate_relative_radius() combines two sides' series.
 // Each estimate is combined with a Gaussian prior around the manifest value; with no
 // information it stays there and says so (observed = false).
 //
-// Per sample: fixed-size arithmetic, no allocation.
+// Per sample: fixed-size arithmetic, no allocation (the rate series is reserved for the
+// expected duration up front).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "wheelins/nav/types.hpp"
 #include "wheelins/nav/vehicle.hpp"
@@ -38,6 +51,10 @@ struct InstallationCalibrationOptions {
   int min_turns = 20;                     ///< fewer whole turns: nothing is estimated
   /// An estimate is "observed" when the data shrink the prior sigma below this fraction.
   double observed_ratio = 0.5;
+  double rate_bin_s = 1.0;                ///< time bins of the relative-radius fit [s]
+  double radius_prior_std = 0.01;         ///< 1 sigma of the manifest radii's ratio [-]
+  double body_mounting_prior_std = 1.0 * kDeg;  ///< 1 sigma of a Body-IMU's manifest mounting
+  double min_yaw_rate = 0.1;              ///< a Body-IMU counts as turning above this [rad/s]
 };
 
 /// An estimate with its 1-sigma and whether the data determined it.
@@ -61,15 +78,67 @@ struct WheelImuCalibration {
   CalibratedValue lever_arm[3];
   Vec3 manifest_lever_arm = Vec3::Zero();
   double accel_residual_rms = 0.0;  ///< per-turn residual of the lever-arm fit [m/s^2]
+  /// The wheel radius relative to the Wheel-IMU(s) on the other side of the vehicle: the
+  /// radius with the relative correction applied (the two sides' mean kept at the
+  /// manifest's; the absolute radius is not observable), its 1 sigma [m]. Without a
+  /// Wheel-IMU on the other side: the manifest's radius, not observed.
+  CalibratedValue wheel_radius;
+  double manifest_wheel_radius = 0.0;
 
   Vec3 lever_arm_inB() const { return {lever_arm[0].value, lever_arm[1].value, lever_arm[2].value}; }
+};
+
+/// Sums over one time bin of a Wheel-IMU's data (bins from the end of the static period).
+struct RateBin {
+  double dt = 0.0;    ///< sampled time in the bin [s]
+  double spin = 0.0;  ///< forward wheel angle, -axle_sign * integral of w_x [rad]
+  double wf = 0.0;    ///< integral of w_y f_y + w_z f_z [rad m/s^2]
+  double w_y = 0.0, w_z = 0.0, f_y = 0.0, f_z = 0.0;  ///< their integrals
+  double cos_a = 0.0, sin_a = 0.0;  ///< integrals of the wheel angle's cosine and sine
+  /// The vehicle yaw rate the wheel sees over the bin [rad/s]: the in-plane rate on the
+  /// down direction -f / g, from the bin's covariance of w and f, so that what is constant
+  /// in the b-frame (a mounting error's share of the spin, the centripetal term of the
+  /// lever arm, biases) does not multiply into a rate. The down direction turns with the
+  /// wheel; over a bin that is not a whole number of turns its covariance with itself is
+  /// 1 - |m|^2, m its mean over the bin: divided out. NaN where the wheel turned too
+  /// little for a rate (|m|^2 > 0.8).
+  double yaw_rate(double g) const {
+    if (!(dt > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    const double spread = 1.0 - (cos_a * cos_a + sin_a * sin_a) / (dt * dt);
+    if (spread < 0.2) return std::numeric_limits<double>::quiet_NaN();
+    return -(wf - (w_y * f_y + w_z * f_z) / dt) / (g * dt * spread);
+  }
+};
+
+/// The sums over the static period before the run: its mean rate is the gyro bias, its
+/// mean specific force gravity as the accelerometer reads it.
+struct StaticPeriodSums {
+  double start = 0.0, end = 0.0;
+  Vec3 dtheta = Vec3::Zero(), dvel = Vec3::Zero();
+  double dt = 0.0;
+  /// True for a sample at or before the static period's end (counted if inside it).
+  bool take(const ImuSample& s) {
+    if (s.t > end) return false;
+    if (s.t > start) {
+      dtheta += s.dtheta;
+      dvel += s.dvel;
+      dt += s.dt;
+    }
+    return true;
+  }
+  Vec3 gyro_bias() const { return dt > 0.0 ? Vec3(dtheta / dt) : Vec3::Zero(); }
+  /// The white-noise part of the bias estimate's 1 sigma [rad/s].
+  double gyro_bias_noise(double arw) const { return dt > 0.0 ? arw / std::sqrt(dt) : 0.0; }
+  double gravity() const { return dt > 0.0 ? std::max(1.0, dvel.norm() / dt) : 9.8; }
 };
 
 class WheelImuCalibrator {
  public:
   /// `static_start`, `static_end`: the static period, whose mean rate is the gyro bias.
+  /// `expected_end`: the time of the last sample if known (the rate series is reserved up
+  /// to it; later samples still count).
   WheelImuCalibrator(const ImuModule& module, double static_start, double static_end,
-                     const InstallationCalibrationOptions& opt = {});
+                     const InstallationCalibrationOptions& opt = {}, double expected_end = 0.0);
 
   /// One raw sample in the sensor axes (as read from the module's file), in time order.
   void add(const ImuSample& sensor_sample);
@@ -78,6 +147,8 @@ class WheelImuCalibrator {
   WheelImuCalibration result() const;
 
   int turns() const { return turns_; }
+  const ImuModule& module() const { return module_; }
+  const std::vector<RateBin>& rate_bins() const { return bins_; }
 
  private:
   struct TurnSums {  // angle-weighted sums over the current turn
@@ -103,9 +174,7 @@ class WheelImuCalibrator {
   ImuModule module_;
   InstallationCalibrationOptions opt_;
   Mat3 C_StoB_;
-  double static_start_, static_end_;
-  Vec3 static_sum_ = Vec3::Zero();
-  double static_dt_ = 0.0;
+  StaticPeriodSums static_;
   double prev_wx_ = 0.0;
   bool have_prev_ = false;
   int spin_sign_ = 0;
@@ -124,6 +193,60 @@ class WheelImuCalibrator {
   Mat3 dir_sq_ = Mat3::Zero();
   int turns_ = 0;
   double spin_angle_ = 0.0, rolling_time_ = 0.0;
+  // Relative radius: the rate series.
+  double wheel_angle_ = 0.0;
+  std::vector<RateBin> bins_;
+
+ public:
+  /// |f| over the static period (gravity as this accelerometer reads it) [m/s^2].
+  double gravity() const {
+    return static_.gravity();
+  }
 };
+
+/// A Body-IMU's mounting against the vehicle frame (C_b^v as ZYX Euler angles).
+struct BodyImuCalibration {
+  std::string module;
+  double turning_time = 0.0;  ///< time spent turning faster than min_yaw_rate [s]
+  /// The correction of the vehicle's z-axis (the yaw axis) as seen in the v-frame given by
+  /// the manifest: small rotations about v x and v y [rad]. The mounting yaw is the
+  /// manifest's (not estimated: docs/filter.md section 15).
+  CalibratedValue tilt_x, tilt_y;
+  Vec3 mounting_rpy = Vec3::Zero();  ///< with the corrections applied [rad]
+  Vec3 manifest_mounting_rpy = Vec3::Zero();
+};
+
+/// The Body-IMU's mounting roll and pitch from its own data (docs/filter.md section 15):
+/// the vehicle's z-axis is the axis it turns about. On any ground a vehicle yaws about its
+/// own z, so the principal axis of the rates' scatter while turning is v z in the b-frame
+/// (the terrain's pitch and roll rates are smaller and uncorrelated with the yaw rate).
+class BodyImuCalibrator {
+ public:
+  BodyImuCalibrator(const ImuModule& module, double static_start, double static_end,
+                    const InstallationCalibrationOptions& opt = {});
+  void add(const ImuSample& sensor_sample);
+  BodyImuCalibration result() const;
+
+ private:
+  void close_chunk();
+  ImuModule module_;
+  InstallationCalibrationOptions opt_;
+  Mat3 C_BtoV_;
+  StaticPeriodSums static_;
+  double chunk_start_ = -1.0, t_ = 0.0;
+  // Turning: the rate scatter, whole run and current chunk; the per-chunk axes.
+  Mat3 turn_all_ = Mat3::Zero(), turn_chunk_ = Mat3::Zero();
+  double turn_time_ = 0.0, turn_chunk_time_ = 0.0, yaw_sum_ = 0.0;
+  Vec3 axis_sum_ = Vec3::Zero(), axis_sq_ = Vec3::Zero();
+  int axis_chunks_ = 0;
+};
+
+/// The relative radius of two sides' Wheel-IMUs from their rate series (module y in the
+/// v-frame tells the sides; more than one module on a side, e.g. several chips on one
+/// wheel, are averaged). Sets `wheel_radius` in each of `results` (same order as
+/// `cals`); a single side leaves every radius at the manifest's, not observed.
+void estimate_relative_radius(const std::vector<const WheelImuCalibrator*>& cals,
+                              const InstallationCalibrationOptions& opt,
+                              std::vector<WheelImuCalibration>& results);
 
 }  // namespace wheelins

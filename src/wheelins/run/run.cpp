@@ -131,7 +131,7 @@ RunResult run_navigation(const RunRequest& r) {
   auto staged = [&](const fs::path& final_file) { return out_dir->staging() / final_file.filename(); };
 
   // The installation calibration pass: the Wheel-IMUs' files read once before navigating.
-  std::vector<WheelImuCalibration> calibration;
+  InstallationCalibration calibration;
   if (r.calibration == CalibrationMode::kEstimate)
     calibration = calibrate_installation(r.manifest, r.modules, r.calibration_options,
                                          r.nav.faults.enabled, r.progress,

@@ -46,7 +46,7 @@ struct RunResult {
   std::string noise_report;                  ///< readable summary of it, with the warnings
   std::vector<WeightRecord> weights;         ///< the reference weights of eq. (8) over time (weights.csv)
   std::string weights_report;                ///< readable summary of them (multi-IMU runs)
-  std::vector<WheelImuCalibration> calibration;  ///< the installation estimates (calibration.yaml)
+  InstallationCalibration calibration;  ///< the installation estimates (calibration.yaml)
   std::string calibration_report;            ///< readable table of them (empty: not estimated)
 };
 
