@@ -1,6 +1,7 @@
 // `wheelins calibrate`: refines a manifest's installation geometry (each Wheel-IMU's axle
-// direction, lever arm and relative radius, each Body-IMU's mounting) from a recording, and writes the refined manifest and the
-// estimates with their 1 sigma (docs/filter.md section 15).
+// direction, lever arm and relative radius, each Body-IMU's roll and pitch) from a
+// recording, and writes the refined manifest and the estimates with their 1 sigma
+// (docs/filter.md section 15).
 #include <cmath>
 #include <filesystem>
 #include <iostream>

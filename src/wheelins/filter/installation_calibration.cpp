@@ -17,6 +17,14 @@ constexpr double kTurn = 2.0 * kPi;
 /// A sample interval longer than this is a gap in the data (a dropout, a removed stretch).
 constexpr double kMaxGap = 0.1;
 
+/// The 1 sigma of a mean over n samples from their sum and sum of squares (the sample
+/// variance with n - 1), with a systematic term added in quadrature.
+double std_of_mean(double sum, double sum_sq, double n, double systematic) {
+  const double mean = sum / n;
+  const double var = std::max(0.0, (sum_sq / n - mean * mean) * n / (n - 1.0));
+  return std::sqrt(var / n + systematic * systematic);
+}
+
 /// A data estimate (value, sigma; sigma = inf: no data) combined with a zero-mean-offset
 /// Gaussian prior around `prior`.
 CalibratedValue with_prior(double prior, double prior_std, double data, double data_std,
@@ -134,7 +142,7 @@ void WheelImuCalibrator::close_turn(int phase) {
     if (len > 0.0) {
       const Vec3 d = turn.rot / len;
       dir_sum_ += d;
-      dir_sq_ += d * d.transpose();
+      dir_sq_ += d.cwiseProduct(d);
     }
     ++turns_;
   }
@@ -176,13 +184,10 @@ WheelImuCalibration WheelImuCalibrator::result() const {
     dy = a.z();
     dz = -a.y();
     const double n = turns_;
-    const Vec3 mean = dir_sum_ / n;
-    const double vy = std::max(0.0, (dir_sq_(1, 1) / n - mean.y() * mean.y()) * n / (n - 1.0));
-    const double vz = std::max(0.0, (dir_sq_(2, 2) / n - mean.z() * mean.z()) * n / (n - 1.0));
     const double arw_static = static_.gyro_bias_noise(module_.noise.gyro_arw);
     const double bias_term = std::hypot(module_.noise.gyro_bias_std, arw_static) * rolling_time_ / spin_angle_;
-    sy = std::sqrt(vz / n + bias_term * bias_term);  // delta_y is a_z
-    sz = std::sqrt(vy / n + bias_term * bias_term);
+    sy = std_of_mean(dir_sum_.z(), dir_sq_.z(), n, bias_term);  // delta_y is a_z
+    sz = std_of_mean(dir_sum_.y(), dir_sq_.y(), n, bias_term);
   }
   r.axle_tilt_y = with_prior(0.0, opt_.mounting_prior_std, dy, sy, opt_.observed_ratio);
   r.axle_tilt_z = with_prior(0.0, opt_.mounting_prior_std, dz, sz, opt_.observed_ratio);
@@ -293,15 +298,12 @@ BodyImuCalibration BodyImuCalibrator::result() const {
     ex = a.x();
     ey = a.y();
     const double n = axis_chunks_;
-    const Vec3 mean = axis_sum_ / n;
-    const double vx = std::max(0.0, (axis_sq_.x() / n - mean.x() * mean.x()) * n / (n - 1.0));
-    const double vy = std::max(0.0, (axis_sq_.y() / n - mean.y() * mean.y()) * n / (n - 1.0));
     // A residual gyro bias b adds b_x * sum(w_z dt) to M_xz.
     const double arw_static = static_.gyro_bias_noise(module_.noise.gyro_arw);
     const double bias_term =
         std::hypot(module_.noise.gyro_bias_std, arw_static) * std::abs(yaw_sum_) / M(2, 2);
-    sx = std::sqrt(vx / n + bias_term * bias_term);
-    sy = std::sqrt(vy / n + bias_term * bias_term);
+    sx = std_of_mean(axis_sum_.x(), axis_sq_.x(), n, bias_term);
+    sy = std_of_mean(axis_sum_.y(), axis_sq_.y(), n, bias_term);
   }
   // The rotation that carries the turn axis a onto v z: phi_x = a_y, phi_y = -a_x.
   r.tilt_x = with_prior(0.0, opt_.body_mounting_prior_std, ey, sy, opt_.observed_ratio);

@@ -149,6 +149,8 @@ class WheelImuCalibrator {
   int turns() const { return turns_; }
   const ImuModule& module() const { return module_; }
   const std::vector<RateBin>& rate_bins() const { return bins_; }
+  /// |f| over the static period (gravity as this accelerometer reads it) [m/s^2].
+  double gravity() const { return static_.gravity(); }
 
  private:
   struct TurnSums {  // angle-weighted sums over the current turn
@@ -190,18 +192,12 @@ class WheelImuCalibrator {
   Mat3 Smm_ = Mat3::Zero();
   // Axle: the summed rotation vectors and the scatter of the per-turn directions.
   Vec3 axle_sum_ = Vec3::Zero(), dir_sum_ = Vec3::Zero();
-  Mat3 dir_sq_ = Mat3::Zero();
+  Vec3 dir_sq_ = Vec3::Zero();  // per-axis sums of squares
   int turns_ = 0;
   double spin_angle_ = 0.0, rolling_time_ = 0.0;
   // Relative radius: the rate series.
   double wheel_angle_ = 0.0;
   std::vector<RateBin> bins_;
-
- public:
-  /// |f| over the static period (gravity as this accelerometer reads it) [m/s^2].
-  double gravity() const {
-    return static_.gravity();
-  }
 };
 
 /// A Body-IMU's mounting against the vehicle frame (C_b^v as ZYX Euler angles).

@@ -15,15 +15,20 @@ namespace fs = std::filesystem;
 InstallationCalibration calibrate_installation(
     const Manifest& m, const std::vector<std::string>& modules,
     const InstallationCalibrationOptions& opt, bool isolate_faults, bool progress, double t_end) {
+  // A binary file's sample count from its size (7 doubles a record); 0 for text files.
+  auto binary_samples = [&](const ModuleSpec& spec) -> std::uint64_t {
+    if (spec.layout != FileLayout::kBinary) return 0;
+    std::error_code ec;
+    const auto size = fs::file_size(m.resolve(spec.file), ec);
+    return ec ? 0 : size / (7 * sizeof(double));
+  };
   std::uint64_t total = 0;
   std::vector<const ModuleSpec*> specs;
   for (const auto& name : modules) {
     const ModuleSpec* spec = m.find(name);
     if (!spec) throw InputError("'" + m.path.string() + "': no module '" + name + "'");
     specs.push_back(spec);
-    std::error_code ec;
-    if (spec->layout == FileLayout::kBinary)
-      total += fs::file_size(m.resolve(spec->file), ec) / (7 * sizeof(double));
+    total += binary_samples(*spec);
   }
   InstallationCalibration out;
   std::vector<std::unique_ptr<WheelImuCalibrator>> wheels;
@@ -34,28 +39,26 @@ InstallationCalibration calibrate_installation(
     // warnings left to the navigation pass (which reads the same file again).
     auto reader = std::make_unique<ImuFileReader>(m.resolve(spec->file), imu_read_options(*spec, {}));
     CheckedStream stream(std::move(reader), *spec, m, isolate_faults, WarningSink{});
-    ImuSample s;
-    if (spec->kind == ModuleKind::kWheel) {
-      // The rate series reserved for the file's span (binary files: from the sample count).
-      double expected_end = t_end;
-      if (!std::isfinite(expected_end) && spec->layout == FileLayout::kBinary && spec->rate_hz > 0.0) {
-        std::error_code ec;
-        expected_end = m.static_start + static_cast<double>(fs::file_size(m.resolve(spec->file), ec) /
-                                                            (7 * sizeof(double))) / spec->rate_hz;
-      }
-      auto cal = std::make_unique<WheelImuCalibrator>(*spec, m.static_start, m.static_end, opt, expected_end);
-      while (stream.next(s) && s.t <= t_end) {
-        cal->add(s);
-        if ((++done & 0xFFFF) == 0) bar.update(done);
-      }
-      out.wheels.push_back(cal->result());
-      wheels.push_back(std::move(cal));
-    } else {
-      BodyImuCalibrator cal(*spec, m.static_start, m.static_end, opt);
+    auto feed = [&](auto& cal) {
+      ImuSample s;
       while (stream.next(s) && s.t <= t_end) {
         cal.add(s);
         if ((++done & 0xFFFF) == 0) bar.update(done);
       }
+    };
+    if (spec->kind == ModuleKind::kWheel) {
+      // The rate series reserved for the file's span (binary files: from the sample count).
+      double expected_end = t_end;
+      const std::uint64_t n = binary_samples(*spec);
+      if (!std::isfinite(expected_end) && n > 0 && spec->rate_hz > 0.0)
+        expected_end = m.static_start + static_cast<double>(n) / spec->rate_hz;
+      auto cal = std::make_unique<WheelImuCalibrator>(*spec, m.static_start, m.static_end, opt, expected_end);
+      feed(*cal);
+      out.wheels.push_back(cal->result());
+      wheels.push_back(std::move(cal));
+    } else {
+      BodyImuCalibrator cal(*spec, m.static_start, m.static_end, opt);
+      feed(cal);
       out.bodies.push_back(cal.result());
     }
   }
@@ -169,7 +172,8 @@ std::string calibration_report(const InstallationCalibration& cal) {
     std::snprintf(line, sizeof line, "  %-10s %5s        wheel radius %.5f +- %.5f (%.5f) m%s\n", "", "",
                   c.wheel_radius.value, c.wheel_radius.std, c.manifest_wheel_radius,
                   c.wheel_radius.observed ? "  (relative to the other side)"
-                                          : "  (no Wheel-IMU on the other side: manifest kept)");
+                                          : "  (not observed: manifest kept; needs a Wheel-IMU on the "
+                                            "other side)");
     t += line;
   }
   for (const auto& c : cal.bodies) {
