@@ -74,10 +74,11 @@ std::vector<Sample> samples_of(const std::vector<std::string>& modules) {
 }
 
 void run_navigator(benchmark::State& state, const std::vector<std::string>& modules,
-                   bool centralized) {
+                   bool centralized, bool turn_average = false) {
   const std::vector<Sample> samples = samples_of(modules);
   NavigatorOptions opt;
   opt.fusion.centralized = centralized;
+  opt.wheel.turn_average = turn_average;
   opt.output_interval = 1.0;  // the filter, not the output (1 Hz records)
   std::uint64_t epochs = 0;
   double seconds = 0.0;
@@ -94,6 +95,13 @@ void run_navigator(benchmark::State& state, const std::vector<std::string>& modu
 
 void BM_EpochSingleWheelIns(benchmark::State& state) { run_navigator(state, {"left-C1"}, false); }
 BENCHMARK(BM_EpochSingleWheelIns)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The velocity model kept at every epoch for the update over a whole wheel turn (off by
+// default; filter/turn_average.hpp).
+void BM_EpochSingleWheelInsTurnAverage(benchmark::State& state) {
+  run_navigator(state, {"left-C1"}, false, true);
+}
+BENCHMARK(BM_EpochSingleWheelInsTurnAverage)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_EpochTripleDistributed(benchmark::State& state) {
   run_navigator(state, {"left-C1", "right-C1", "body-C1"}, false);

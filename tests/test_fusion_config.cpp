@@ -61,6 +61,7 @@ chips: [C1, C2, C4]
 output: {dir: out/t, formats: [csv], interval_s: 0.1, overwrite: true}
 filter:
   velocity_update_hz: 4
+  velocity_average: whole-turns
   covariance_interval_s: 0.02
   wheel_velocity_std_m_s: [0.05, 0.03, 0.03]
   initial_std: {heading_deg: 0.5}
@@ -77,6 +78,7 @@ faults: {heading_gate_deg: 8, window: 30, max_failed: 20, probation_s: 5}
   EXPECT_TRUE(c.overwrite);
   EXPECT_DOUBLE_EQ(c.nav.output_interval, 0.1);
   EXPECT_DOUBLE_EQ(c.nav.wheel.velocity_update_interval, 0.25);
+  EXPECT_TRUE(c.nav.wheel.turn_average);
   EXPECT_DOUBLE_EQ(c.nav.covariance_interval, 0.02);
   EXPECT_DOUBLE_EQ(c.nav.wheel.velocity_std.x(), 0.05);
   EXPECT_NEAR(c.nav.wheel.init.heading, 0.5 * kDeg, 1e-15);
@@ -103,6 +105,9 @@ TEST(FusionRunConfig, BadValuesNameTheKeyAndLine) {
   e = load("dataset: m.yaml\nfilter:\n  velocity_update_hz: fast\n");
   EXPECT_NE(e.find("filter.velocity_update_hz: expected a number, got 'fast' (line 3)"),
             std::string::npos) << e;
+  e = load("dataset: m.yaml\nfilter:\n  velocity_average: turns\n");
+  EXPECT_NE(e.find("filter.velocity_average"), std::string::npos) << e;
+  EXPECT_NE(e.find("whole-turns"), std::string::npos) << e;
   e = load("dataset: m.yaml\nfilter:\n  wheel_velocity_std_m_s: [0.03, -1, 0.02]\n");
   EXPECT_NE(e.find("filter.wheel_velocity_std_m_s[1]: must be in [0.0001, 10] m/s, got -1"), std::string::npos) << e;
   e = load("dataset: m.yaml\nfilter:\n  covariance_interval_s: 2\n");

@@ -27,6 +27,8 @@ void StrapdownEkf::initialize(const NavState& state, const ImuErrors& errors,
   P_.block<3, 3>(SA, SA).diagonal().setConstant(noise.acc_sf_std * noise.acc_sf_std);
   P_.diagonal() = P_.diagonal().cwiseProduct(noise.estimated);  // held states: no uncertainty
   ++starts_;
+  ++revision_;
+  feedback_total_.setZero();
   S_.setZero();
   held_var_.setZero();
   n_held_ = 0;
@@ -98,6 +100,7 @@ void StrapdownEkf::feedback(const Vec21& dx) {
   errors_.ba += dx.segment<3>(BA);
   errors_.sg += dx.segment<3>(SG);
   errors_.sa += dx.segment<3>(SA);
+  feedback_total_ += dx;
 }
 
 void StrapdownEkf::set_noise(const ProcessNoise& noise) {

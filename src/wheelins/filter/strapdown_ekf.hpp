@@ -121,7 +121,17 @@ class StrapdownEkf {
   /// Applies an error estimate (position, velocity, attitude, sensor errors) to the state.
   void feedback(const Vec21& dx);
   /// Replaces the sensor-error estimates (e.g. with earlier ones after a fault).
-  void set_errors(const ImuErrors& e) { errors_ = e; }
+  void set_errors(const ImuErrors& e) {
+    errors_ = e;
+    ++revision_;
+  }
+  /// The sum of every correction fed back since the last initialize() (to first order: the
+  /// attitude parts add as rotation vectors). A model evaluated at an earlier epoch is brought
+  /// to the current estimates by -H (total now - total then) (filter/turn_average.hpp).
+  const Vec21& feedback_total() const { return feedback_total_; }
+  /// Changes when the estimates change other than by feedback (initialize(), set_errors()):
+  /// models kept from before are not comparable any more.
+  int revision() const { return revision_; }
 
  private:
   NavState state_;
@@ -137,6 +147,8 @@ class StrapdownEkf {
   bool have_last_ = false;
   bool initialized_ = false;
   int starts_ = 0;
+  int revision_ = 0;
+  Vec21 feedback_total_ = Vec21::Zero();
   // Consider analysis of the held states (reported_covariance).
   Eigen::Matrix<double, kStateDim, kMaxHeld> S_ = Eigen::Matrix<double, kStateDim, kMaxHeld>::Zero();
   Eigen::Matrix<double, kMaxHeld, 1> held_var_ = Eigen::Matrix<double, kMaxHeld, 1>::Zero();

@@ -25,6 +25,9 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
   // The accelerometer along the axle sees the lateral specific force only: its scale factor
   // and its bias differ only where the course turns both ways (held as well).
   if (!opt.estimate_axle_accel_scale_factor) noise_.estimated(SA + 0) = 0.0;
+  if (opt.turn_average)
+    turns_.reserve(std::clamp(static_cast<int>(std::ceil(opt.turn_window * module.rate_hz)) + 1, 2,
+                              kMaxTurnEpochs));
 }
 
 ImuSample WheelIns::to_body(const ImuSample& s) const {
@@ -96,6 +99,29 @@ void WheelIns::propagate(const ImuSample& body_sample) {
   window_[window_pos_] = wx;
   window_sum_ += wx;
   window_pos_ = (window_pos_ + 1) % window_len_;
+  if (opt_.turn_average) {
+    // Models kept from before a restart or replaced estimates are not comparable.
+    if (ekf_.revision() != turns_revision_) {
+      turns_.clear();
+      turns_revision_ = ekf_.revision();
+    }
+    WheelVelocityInput in = own_velocity_input();
+    in.measured_speed = in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
+    turns_.add(wheel_velocity_model(in), ekf_.feedback_total(),
+               Eigen::Vector2d(vehicle_roll_, vehicle_pitch_), wx, body_sample.dt);
+  }
+}
+
+bool WheelIns::turn_averaged(const WheelVelocityInput& now, TurnAverage& out,
+                             WheelVelocityInput& speed) const {
+  if (!opt_.turn_average || ekf_.revision() != turns_revision_) return false;
+  if (!turns_.average(ekf_.feedback_total(), Eigen::Vector2d(now.vehicle_roll, now.vehicle_pitch),
+                      out))
+    return false;
+  const ImuErrors& e = ekf_.errors();
+  speed.axle_sign = axle_sign_;
+  set_own_wheel_speed(speed, module_.wheel_radius, (out.mean_omega_x - e.bg.x()) / (1.0 + e.sg.x()));
+  return true;
 }
 
 double WheelIns::mean_omega_x() const {

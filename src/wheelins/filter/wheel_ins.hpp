@@ -7,6 +7,7 @@
 #include <array>
 
 #include "wheelins/filter/subsystem.hpp"
+#include "wheelins/filter/turn_average.hpp"
 #include "wheelins/filter/wheel_velocity.hpp"
 
 namespace wheelins {
@@ -25,11 +26,21 @@ struct WheelInsOptions {
   /// which on a course that turns mostly one way is indistinguishable from its bias: held
   /// by default (docs/filter.md 13.4).
   bool estimate_axle_accel_scale_factor = false;
+  /// The velocity update over a whole wheel turn (filter/turn_average.hpp): the model of
+  /// eq. (5) and the measured speed averaged over the last whole turn, so the errors that turn
+  /// with the wheel (lever arm, axle direction) cancel. Off (the default; measured in
+  /// docs/filter.md 15.6): the model at the update epoch and the speed over speed_window
+  /// (the paper's).
+  bool turn_average = false;
+  /// The longest span kept for it [s]; slower than a turn in this, the update is the
+  /// instantaneous one.
+  double turn_window = 4.0;
 };
 
 class WheelIns final : public Subsystem {
  public:
   static constexpr int kMaxWindow = 256;
+  static constexpr int kMaxTurnEpochs = 1 << 15;
 
   WheelIns(const ImuModule& module, const WheelInsOptions& opt, const MechanizationOptions& mech);
 
@@ -65,6 +76,12 @@ class WheelIns final : public Subsystem {
   /// The velocity/NHC measurement input (wheel_velocity_model()) with this wheel's own
   /// speed and the current vehicle roll/pitch.
   WheelVelocityInput own_velocity_input() const;
+  bool turn_averaging() const { return opt_.turn_average; }
+  /// The velocity model and this wheel's speed averaged over the last whole turn, at
+  /// the level of `now` (its vehicle roll, pitch); false when off or under one whole turn.
+  /// `speed` gets the measured speed fields (set_own_wheel_speed over the same epochs).
+  bool turn_averaged(const WheelVelocityInput& now, TurnAverage& out,
+                     WheelVelocityInput& speed) const;
 
   /// Vehicle roll/pitch assumed in the velocity model (0: horizontal-plane assumption;
   /// set by a Body-INS when one shares its attitude).
@@ -93,6 +110,8 @@ class WheelIns final : public Subsystem {
   std::array<double, kMaxWindow> window_{};
   int window_len_ = 1, window_count_ = 0, window_pos_ = 0;
   double window_sum_ = 0.0;
+  TurnAverager turns_;
+  int turns_revision_ = -1;
 };
 
 }  // namespace wheelins

@@ -48,7 +48,6 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
 
   WheelVelocityModel m;
   m.z_hat = C_WtoV * u;
-  m.z_meas = Vec3(in.measured_speed, 0.0, 0.0);
 
   // d z_hat / d dv  (eq. 5, second term)
   m.H.block<3, 3>(0, V) = C_WtoV;
@@ -65,15 +64,20 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   const Mat3 Hbg = -C_WtoV * C * skew(l);
   m.H.block<3, 3>(0, BG) = Hbg;
   m.H.block<3, 3>(0, SG) = Hbg * in.omega_ib_b.asDiagonal();
-  // The measured speed comes from the same compensated gyro: dz = z_hat - z_meas.
-  m.H(0, BG) -= in.dspeed_dbgx;
-  m.H(0, SG) -= in.dspeed_dsgx;
+  set_measured_speed(m, in.measured_speed, in.dspeed_dbgx, in.dspeed_dsgx);
   // z_hat = Rx(phi)^T Ry(theta)^T Rz^T u; d Rx^T/d phi = -[e_x x] Rx^T, same for Ry.
   const Mat3 Rx = rot_x(in.vehicle_roll), Ry = rot_y(in.vehicle_pitch);
   m.H_level.col(0) = -skew(Vec3::UnitX()) * C_WtoV * u;
   m.H_level.col(1) = -Rx.transpose() * skew(Vec3::UnitY()) * Ry.transpose() * Rz.transpose() * u;
 
   return m;
+}
+
+void set_measured_speed(WheelVelocityModel& m, double speed, double dspeed_dbgx,
+                        double dspeed_dsgx) {
+  m.z_meas = Vec3(speed, 0.0, 0.0);
+  m.H(0, BG) -= dspeed_dbgx;
+  m.H(0, SG) -= dspeed_dsgx;
 }
 
 }  // namespace wheelins

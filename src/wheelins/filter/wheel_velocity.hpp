@@ -60,4 +60,9 @@ Eigen::RowVector3d wheel_heading_sensitivity(const Mat3& C_BtoW);
 
 WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in);
 
+/// Sets the measured [speed, 0, 0] of `m` and, since the speed comes from the compensated
+/// gyro x (dz = z_hat - z_meas), its sensitivities to b_g,x and s_g,x in the first row of H.
+void set_measured_speed(WheelVelocityModel& m, double speed, double dspeed_dbgx,
+                        double dspeed_dsgx);
+
 }  // namespace wheelins

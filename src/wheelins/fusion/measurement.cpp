@@ -27,12 +27,14 @@ void take_level(const Subsystems& subs, bool shared, bool now, SharedInputs& sh)
 void take_wheel_inputs(const Subsystems& subs, const std::array<bool, kMaxModules>& in_use,
                        SharedInputs& sh) {
   for (int i = 0; i < subs.size(); ++i) {
+    sh.turn_valid[i] = false;
     if (!subs.is_wheel(i) || !in_use[i]) continue;
     WheelVelocityInput& in = sh.wheel[i] = subs.wheel(i).own_velocity_input();
     if (sh.level_now) {
       in.vehicle_roll = sh.level_rpy.x();
       in.vehicle_pitch = sh.level_rpy.y();
     }
+    sh.turn_valid[i] = subs.wheel(i).turn_averaged(in, sh.turn[i], sh.turn_speed[i]);
   }
 }
 
@@ -49,6 +51,14 @@ void take_mean_speed(const Subsystems& subs, const SpeedSelection& sel, SharedIn
     sh.mean_speed /= sel.n_mean;
     sh.mean_point /= sel.n_mean;
   }
+  sh.turn_mean_ok = sel.n_mean > 0;
+  sh.turn_mean_speed = 0.0;
+  for (int j = 0; j < subs.size(); ++j)
+    if (sel.in_mean[j]) {
+      sh.turn_mean_ok = sh.turn_mean_ok && sh.turn_valid[j];
+      sh.turn_mean_speed += sh.turn_speed[j].measured_speed;
+    }
+  if (sh.turn_mean_ok) sh.turn_mean_speed /= sel.n_mean;
 }
 
 void take_reference(const Subsystems& subs, SharedInputs& sh) {
@@ -71,6 +81,7 @@ void velocity_measurement(const Subsystems& subs, const SharedInputs& sh, const 
   const SpeedSelection& sel = sh.speeds;
   const int n_mean = sel.n_mean;
   bool mean = false;  // the measured speed is the mean: its sensitivities are added below
+  bool turn = false;  // ... of the whole-turn speeds
   if (subs.is_wheel(i)) {
     const WheelIns& w = subs.wheel(i);
     WheelVelocityInput in = sh.wheel[i];
@@ -89,7 +100,19 @@ void velocity_measurement(const Subsystems& subs, const SharedInputs& sh, const 
       in.measured_speed = sh.mean_speed;
       in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
     }
-    const WheelVelocityModel wm = wheel_velocity_model(in);
+    // Over whole turns when this wheel averages and every speed it uses has the same mean.
+    const bool no_speed = !sel.speed_ok[i] && n_mean == 0;
+    turn = sh.turn_valid[i] && (no_speed || !mean || sh.turn_mean_ok);
+    WheelVelocityModel wm;
+    if (turn) {
+      wm = sh.turn[i].model;
+      const WheelVelocityInput& own = sh.turn_speed[i];
+      if (no_speed) set_measured_speed(wm, in.measured_speed, 0.0, 0.0);
+      else if (mean) set_measured_speed(wm, sh.turn_mean_speed, 0.0, 0.0);
+      else set_measured_speed(wm, own.measured_speed, own.dspeed_dbgx, own.dspeed_dsgx);
+    } else {
+      wm = wheel_velocity_model(in);
+    }
     m.H[i] = wm.H;
     add_level_block(subs, sh, wm.H_level, 1.0, m);
     m.dz = wm.innovation();
@@ -130,8 +153,9 @@ void velocity_measurement(const Subsystems& subs, const SharedInputs& sh, const 
   if (mean)
     for (int j = 0; j < subs.size(); ++j) {
       if (!sel.in_mean[j]) continue;
-      m.H[j](0, BG) -= sh.wheel[j].dspeed_dbgx / n_mean;
-      m.H[j](0, SG) -= sh.wheel[j].dspeed_dsgx / n_mean;
+      const WheelVelocityInput& sp = turn ? sh.turn_speed[j] : sh.wheel[j];
+      m.H[j](0, BG) -= sp.dspeed_dbgx / n_mean;
+      m.H[j](0, SG) -= sp.dspeed_dsgx / n_mean;
     }
   // The own block: this IMU's share of a mean speed is its own gyro, so it is in both.
   m.H_own = m.H[i];

@@ -72,6 +72,14 @@ struct SharedInputs {
   std::array<WheelVelocityInput, kMaxModules> wheel;
   SpeedSelection speeds;
   double mean_speed = 0.0;          ///< over speeds.in_mean [m/s]
+  /// Each Wheel-INS that averages over whole turns (WheelIns::turn_averaged): the model and
+  /// its speed over its last whole turns (turn_valid false: off, or under a turn).
+  std::array<bool, kMaxModules> turn_valid{};
+  std::array<TurnAverage, kMaxModules> turn;
+  std::array<WheelVelocityInput, kMaxModules> turn_speed;
+  /// The mean of the whole-turn speeds over speeds.in_mean, when every one of them has one.
+  bool turn_mean_ok = false;
+  double turn_mean_speed = 0.0;
   Vec3 mean_point = Vec3::Zero();   ///< the mean of their wheel centres, v-frame [m]
 
   // The reference point of the position-constraint step (Algorithm 1).

@@ -49,6 +49,10 @@ std::string NavigatorOptions::describe() const {
   auto onoff = [](bool b) { return b ? "on" : "off"; };
   o << "velocity update interval:   " << wheel.velocity_update_interval << " s\n"
     << "wheel speed window:         " << wheel.speed_window << " s\n"
+    << "Wheel-INS velocity model:   "
+    << (wheel.turn_average ? "averaged over the last whole wheel turn (within " +
+                                 std::to_string(wheel.turn_window) + " s)"
+                           : std::string("at the update epoch (paper)")) << "\n"
     << "wheel speed sharing:        "
     << (fusion.speed == SpeedSharing::kMean ? "mean of Wheel-IMUs (paper)" : "own wheel (Body-INS: their mean)") << "\n"
     << "Wheel-INS velocity sigma:   " << wheel.velocity_std.transpose() << " m/s\n"

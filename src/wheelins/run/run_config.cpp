@@ -102,7 +102,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   if (auto f = y.get(root, "filter"); f.IsDefined()) {
     y.require_map(f, "filter");
     y.check_keys(f, "filter",
-                 {"mechanization", "earth_rotation", "velocity_update_hz", "speed_window_s",
+                 {"mechanization", "earth_rotation", "velocity_update_hz", "velocity_average", "speed_window_s",
                   "wheel_velocity_std_m_s", "body_velocity_std_m_s", "velocity_gate",
                   "initial_std", "covariance_interval_s", "yaw_scale_factors",
                   "estimate_yaw_scale_factors", "estimate_axle_accel_scale_factors"});
@@ -139,6 +139,9 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
       const double hz = y.number_in(v, "filter.velocity_update_hz", 0.05, 100.0, "Hz");
       c.nav.wheel.velocity_update_interval = 1.0 / hz;
     }
+    if (auto v = y.get(f, "velocity_average"); v.IsDefined())
+      c.nav.wheel.turn_average = y.choice<bool>(v, "filter.velocity_average",
+                                                {{"whole-turns", true}, {"none", false}});
     if (auto v = y.get(f, "speed_window_s"); v.IsDefined()) {
       c.nav.wheel.speed_window = y.number_in(v, "filter.speed_window_s", 0.001, 2.0, "s");
     }
