@@ -13,6 +13,8 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
       opt_(opt),
       C_StoB_(dcm_from_euler(module.mounting_rpy)),
       axle_sign_(module.axle_sign) {
+  // Its b x-axis is the axle: the attitude update splits the spin off (nav/mechanization.hpp).
+  mech_.spin_about_x = true;
   window_len_ = std::clamp(static_cast<int>(std::lround(opt.speed_window * module.rate_hz)), 1,
                            kMaxWindow);
   // The gyro axes in the wheel plane see the vehicle's yaw rate in turn as the wheel rolls:
