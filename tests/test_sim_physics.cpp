@@ -247,3 +247,21 @@ TEST(SimPhysics, DefaultScenarioShape) {
   EXPECT_GT(min_radius, 1.0);
   EXPECT_LT(min_radius, 3.0);
 }
+
+// A corrupt sample of a whole turn (2 pi) about the axle: the split's 1 / sinc(pi) would
+// blow the in-plane part up by 1e16; beyond 2 rad per sample the update is the two-sample
+// form's.
+TEST(SimPhysics, WheelImuSpinSplitStaysFiniteOnACorruptSample) {
+  MechanizationOptions opt, two;
+  opt.spin_about_x = true;
+  ImuSample s;
+  s.dt = 0.01;
+  s.dtheta = Vec3(2.0 * kPi, 0.01, -0.02);
+  const AttitudeIncrement a = attitude_increment(opt, s, s);
+  EXPECT_TRUE(a.q.coeffs().allFinite());
+  EXPECT_TRUE(a.phi.isApprox(attitude_increment(two, s, s).phi)) << a.phi.transpose();
+  s.dtheta.x() = 0.45;  // a car wheel at 100 Hz: the split, a unit quaternion
+  const AttitudeIncrement b = attitude_increment(opt, s, s);
+  EXPECT_NEAR(b.q.norm(), 1.0, 1e-15);
+  EXPECT_TRUE(Quat(dcm_from_rotvec(b.phi)).isApprox(b.q) || Quat(dcm_from_rotvec(b.phi)).isApprox(Quat(-b.q.coeffs())));
+}

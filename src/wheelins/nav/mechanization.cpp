@@ -10,7 +10,9 @@ AttitudeIncrement attitude_increment(const MechanizationOptions& opt, const ImuS
                                      const ImuSample& cur) {
   const Vec3& dth = cur.dtheta;
   AttitudeIncrement a;
-  if (!opt.spin_about_x) {  // the two-sample coning correction
+  // Beyond 2 rad of spin per sample (200 rad/s at 100 Hz: no wheel; a corrupt sample) the
+  // split's 1 / sinc grows without bound: the two-sample form, which stays finite.
+  if (!opt.spin_about_x || std::abs(dth.x()) > 2.0) {  // the two-sample coning correction
     a.phi = dth + prev.dtheta.cross(dth) / 12.0;
     a.q = quat_from_rotvec(a.phi);
     return a;
