@@ -228,7 +228,7 @@ TEST(TurnAverage, ALeverArmErrorLeavesTheAveragedInnovationNotTheInstantaneousOn
 }
 
 TEST(TurnAverage, OffByDefault) {
-  // Measured (docs/filter.md 15.6): with the estimated geometry it gains nothing, and on the
+  // Measured (docs/filter.md 15.1): with the estimated geometry it gains nothing, and on the
   // car's field profile it loses; the paper's instantaneous update stays the default.
   EXPECT_FALSE(WheelInsOptions{}.turn_average);
 }

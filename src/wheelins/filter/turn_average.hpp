@@ -1,4 +1,4 @@
-// The wheel velocity model averaged over whole wheel turns (docs/filter.md section 15.6).
+// The wheel velocity model averaged over whole wheel turns (docs/filter.md section 15.1).
 //
 // A lever arm or an axle direction that is slightly wrong makes an error in the predicted
 // wheel-centre velocity of eq. (5) that turns with the wheel: C_b^w (omega x dl) for a lever

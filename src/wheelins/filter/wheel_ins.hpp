@@ -29,7 +29,7 @@ struct WheelInsOptions {
   /// The velocity update over a whole wheel turn (filter/turn_average.hpp): the model of
   /// eq. (5) and the measured speed averaged over the last whole turn, so the errors that turn
   /// with the wheel (lever arm, axle direction) cancel. Off (the default; measured in
-  /// docs/filter.md 15.6): the model at the update epoch and the speed over speed_window
+  /// docs/filter.md 15.1): the model at the update epoch and the speed over speed_window
   /// (the paper's).
   bool turn_average = false;
   /// The longest span kept for it [s]; slower than a turn in this, the update is the
