@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/io/truth.hpp"
+#include "wheelins/run/calibration.hpp"
 #include "wheelins/run/input_checks.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
@@ -289,13 +291,24 @@ class StreamNavigator {
                   std::optional<bool> centralized, std::optional<bool> position_constraint,
                   std::optional<bool> fault_handling, std::optional<double> duration,
                   std::optional<double> output_interval, std::optional<double> covariance_interval,
-                  const std::string& yaw_scale_factors) {
+                  const std::string& yaw_scale_factors, const std::string& calibration,
+                  double calibration_warmup) {
+    // It sees each sample once. "manifest" (the default): the manifest's geometry as it is
+    // (a calibrated manifest comes from `wheelins calibrate`). "estimate": the installation
+    // geometry estimated from the first `calibration_warmup` seconds after the static period,
+    // whose samples are kept and navigated when it ends (docs/python.md).
     Settings s{configuration, text(config).value_or(""), speed, "", chips, modules, {},
                centralized, position_constraint, fault_handling, std::nullopt, duration, output_interval,
-               covariance_interval, yaw_scale_factors, "manifest"};
-    // It sees each sample once: the manifest's geometry as it is (a calibrated manifest
-    // comes from `wheelins calibrate`).
+               covariance_interval, yaw_scale_factors, calibration.empty() ? "manifest" : calibration};
     req_ = make_run_request(run_config(text(manifest).value_or(""), s), stderr_sink());
+    if (req_.calibration == CalibrationMode::kEstimate) {
+      if (!(calibration_warmup > 0.0) || !std::isfinite(calibration_warmup))
+        throw InputError("calibration_warmup must be a positive number of seconds (given " +
+                         io_detail::format_double(calibration_warmup) + ")");
+      // As a run with a duration: the estimates from no sample past it.
+      const double w = req_.max_duration > 0.0 ? std::min(calibration_warmup, req_.max_duration) : calibration_warmup;
+      warmup_ = std::make_unique<CalibrationWarmup>(req_.manifest, req_.modules, req_.calibration_options, w);
+    }
     req_.output_dir.clear();
     validate_run_request(req_);
     tracks_.reserve(req_.modules.size());  // (InputChecks keeps a reference to its spec)
@@ -305,9 +318,14 @@ class StreamNavigator {
                               InputChecks(*spec, req_.manifest, req_.nav.faults.enabled, stderr_sink(),
                                           "module '" + name + "' (pushed samples)")});
     }
+    if (!warmup_) make_navigator(req_.manifest);
+  }
+
+  /// The navigator, on the manifest (refined by the warm-up's estimates, if any).
+  void make_navigator(const Manifest& manifest) {
     NavigatorOptions nav = req_.nav;
     nav.module_records = false;  // as a run that writes no subsystem files
-    nav_ = std::make_unique<Navigator>(req_.manifest, req_.modules, nav, [this](int stream, const TrajectoryRecord& r) {
+    nav_ = std::make_unique<Navigator>(manifest, req_.modules, nav, [this](int stream, const TrajectoryRecord& r) {
       if (stream != 0 || non_finite_) return;
       // As the run driver: a record that is not finite is never passed on.
       if (!(std::isfinite(r.t) && r.p_inN.allFinite() && r.v_inN.allFinite() && r.rpy.allFinite() &&
@@ -372,18 +390,39 @@ class StreamNavigator {
     // The run's input checks (run/input_checks.hpp): a sample beyond the sensor range is
     // left out (its interval goes to the next one), the rate, format and static period checked.
     if (!tr.checks.admit(s, index)) return !stopped_;
+    if (warmup_ && !nav_) {
+      if (warmup_->add(i, s)) return true;
+      end_warmup();
+      if (stopped_) return false;
+    }
+    navigate(i, s);
+    return !stopped_;
+  }
+
+  /// The warm-up's estimates made, the navigator built with them and the kept samples navigated.
+  void end_warmup() {
+    calibration_ = warmup_->result();
+    make_navigator(apply_calibration(req_.manifest, calibration_));
+    for (const auto& k : warmup_->kept()) {
+      navigate(k.index, k.sample);
+      if (stopped_) break;
+    }
+    warmup_->release();
+  }
+
+  void navigate(int i, const ImuSample& s) {
     nav_->process(i, s);
     if (non_finite_)
       throw InputError("the navigation became non-finite (the vehicle solution) by t = " +
                        io_detail::format_double(non_finite_t_) + " s: the filter diverged (an input or a setting "
                        "outside what the checks catch)");
     if (req_.max_duration > 0 && nav_->navigating() && s.t - nav_->stats().t_start >= req_.max_duration) stopped_ = true;
-    return !stopped_;
   }
 
   void finish() {
     if (finished_) return;
     for (auto& tr : tracks_) tr.checks.finish();
+    if (!nav_) end_warmup();  // the data ended inside the warm-up: estimates from all of it
     if (!nav_->navigating()) {
       char period[96];
       std::snprintf(period, sizeof period, "[%.3f, %.3f] s", req_.manifest.static_start, req_.manifest.static_end);
@@ -395,7 +434,7 @@ class StreamNavigator {
   }
 
   py::object state() const {
-    if (!nav_->navigating()) return py::none();
+    if (!navigating()) return py::none();
     const TrajectoryRecord r = nav_->vehicle_record();
     const auto names = trajectory_csv_header();
     std::vector<double> v(names.size());
@@ -407,6 +446,8 @@ class StreamNavigator {
 
   py::array_t<double> covariance(const py::object& module) const {
     const int i = index_of(module);
+    if (!nav_) throw InputError("no covariance during the calibration warm-up (it ends at t = " +
+                                io_detail::format_double(warmup_->end()) + " s)");
     if (!nav_->navigating()) throw InputError("no covariance before navigation starts (the static period)");
     if (req_.nav.fusion.centralized)
       throw InputError("the centralized filter keeps one joint covariance; its per-module blocks are not "
@@ -419,11 +460,23 @@ class StreamNavigator {
   }
 
   const std::vector<std::string>& modules() const { return req_.modules; }
-  bool navigating() const { return nav_->navigating(); }
+  bool navigating() const { return nav_ && nav_->navigating(); }
   py::array_t<double> records() const { return table(records_); }
   std::size_t record_count() const { return records_.size(); }
-  py::dict stats() const { return stats_dict(nav_->stats()); }
-  std::string fault_report() const { return fault_report_text(nav_->faults()); }
+  py::dict stats() const { return stats_dict(nav_ ? nav_->stats() : NavigatorStats{}); }
+  std::string fault_report() const {
+    return nav_ ? fault_report_text(nav_->faults()) : std::string("(calibration warm-up: nothing navigated yet)\n");
+  }
+  /// The warm-up's estimates (calibration.yaml's text; None with the manifest's geometry or
+  /// during the warm-up).
+  py::object calibration() const {
+    if (!warmup_ || !nav_) return py::none();
+    return py::str(calibration_yaml(calibration_, req_.manifest));
+  }
+  py::object calibration_report() const {
+    if (!warmup_ || !nav_) return py::none();
+    return py::str(wheelins::calibration_report(calibration_));
+  }
 
  private:
   struct Track {
@@ -435,6 +488,8 @@ class StreamNavigator {
   RunRequest req_;
   std::vector<Track> tracks_;
   std::unique_ptr<Navigator> nav_;
+  std::unique_ptr<CalibrationWarmup> warmup_;  ///< calibration "estimate": until its end
+  InstallationCalibration calibration_;
   std::vector<TrajectoryRecord> records_;
   double last_t_ = -std::numeric_limits<double>::infinity();
   bool stopped_ = false, finished_ = false, non_finite_ = false;
@@ -492,13 +547,14 @@ PYBIND11_MODULE(_core, m) {
   py::class_<StreamNavigator>(m, "Navigator")
       .def(py::init<const py::object&, const std::string&, const std::vector<std::string>&, const std::vector<std::string>&,
                     const py::object&, const std::string&, std::optional<bool>, std::optional<bool>, std::optional<bool>,
-                    std::optional<double>, std::optional<double>, std::optional<double>, const std::string&>(),
+                    std::optional<double>, std::optional<double>, std::optional<double>, const std::string&,
+                    const std::string&, double>(),
            py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
            py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("speed") = "",
            py::arg("centralized") = py::none(), py::arg("position_constraint") = py::none(),
            py::arg("fault_handling") = py::none(), py::arg("duration") = py::none(),
            py::arg("output_interval") = py::none(), py::arg("covariance_interval") = py::none(),
-           py::arg("yaw_scale_factors") = "")
+           py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("calibration_warmup") = 120.0)
       .def("push", &StreamNavigator::push, py::arg("module"), py::arg("t"), py::arg("gyro"), py::arg("accel"))
       .def("finish", &StreamNavigator::finish)
       .def("covariance", &StreamNavigator::covariance, py::arg("module") = 0)
@@ -508,5 +564,7 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("table", &StreamNavigator::records)
       .def_property_readonly("record_count", &StreamNavigator::record_count)
       .def_property_readonly("stats", &StreamNavigator::stats)
-      .def_property_readonly("fault_report", &StreamNavigator::fault_report);
+      .def_property_readonly("fault_report", &StreamNavigator::fault_report)
+      .def_property_readonly("calibration", &StreamNavigator::calibration)
+      .def_property_readonly("calibration_report", &StreamNavigator::calibration_report);
 }

@@ -14,9 +14,11 @@
 
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/filter/installation_calibration.hpp"
+#include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/trajectory.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/run/calibration.hpp"
+#include "wheelins/run/input_checks.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/sim/simulator.hpp"
@@ -400,4 +402,46 @@ TEST_F(SimulatedCalibration, CalibrateCommandWritesARefinedManifestAndNeverTheIn
   EXPECT_NE(unknown.code, 0);
   EXPECT_NE(unknown.err.find("nosuch"), std::string::npos) << unknown.err;
   EXPECT_FALSE(fs::exists(scratch / "n.yaml"));
+}
+
+TEST_F(SimulatedCalibration, WarmupOfAStreamGivesTheRunsEstimatesFromItsSpan) {
+  // The streaming navigator's calibration: the samples up to static end + warm-up are kept
+  // and calibrated; they equal calibrate_installation() with that end, to the last digit.
+  const Manifest m = load_manifest(*dir_ / "manifest.yaml", {});
+  const std::vector<std::string> modules = configuration_modules(m, "triple", {});
+  const double warmup = 60.0;
+  CalibrationWarmup w(m, modules, {}, warmup);
+  EXPECT_DOUBLE_EQ(w.end(), m.static_end + warmup);
+  std::size_t kept = 0, refused = 0;
+  for (std::size_t k = 0; k < modules.size(); ++k) {
+    const ModuleSpec* spec = m.find(modules[k]);
+    CheckedStream stream(std::make_unique<ImuFileReader>(m.resolve(spec->file), imu_read_options(*spec, {})),
+                         *spec, m, true, WarningSink{});
+    ImuSample s;
+    while (stream.next(s)) {
+      if (w.add(static_cast<int>(k), s)) {
+        ++kept;
+        EXPECT_LE(s.t, w.end());
+      } else {
+        ++refused;
+        EXPECT_GT(s.t, w.end());
+        break;
+      }
+    }
+  }
+  EXPECT_EQ(refused, modules.size());
+  ASSERT_EQ(w.kept().size(), kept);
+  EXPECT_EQ(w.kept().front().index, 0);
+  EXPECT_EQ(w.kept().back().index, static_cast<int>(modules.size()) - 1);
+  const InstallationCalibration from_warmup = w.result();
+  const InstallationCalibration from_files = calibrate_installation(m, modules, {}, true, false, w.end());
+  ASSERT_EQ(from_warmup.wheels.size(), 2u);
+  ASSERT_EQ(from_warmup.bodies.size(), 1u);
+  EXPECT_GT(from_warmup.wheels[0].turns, 20);
+  EXPECT_EQ(calibration_yaml(from_warmup, m), calibration_yaml(from_files, m));
+  // and it is not the whole run's (the span matters)
+  EXPECT_NE(calibration_yaml(from_warmup, m),
+            calibration_yaml(calibrate_installation(m, modules, {}, true, false), m));
+  w.release();
+  EXPECT_TRUE(w.kept().empty());
 }

@@ -198,6 +198,51 @@ def test_streaming_navigator_applies_the_runs_input_checks(dataset, tmp_path):
     same_as_csv(nav.trajectory, read_csv(tmp_path / "out" / "trajectory.csv"))
 
 
+def test_streaming_navigator_estimates_the_geometry_over_a_warmup(dataset, tmp_path):
+    """calibration="estimate": the samples of the first calibration_warmup seconds after the
+    static period are kept and calibrated, then navigated with the estimates. A warm-up
+    longer than the data is the run's calibration from all of it (the run's trajectory to the
+    last digit); a shorter one gives the run's estimates from that many seconds."""
+    manifest = dataset["manifest"]
+    cli("run", "-m", manifest, "-c", "body-wheel", "-o", tmp_path / "all", "-q", "--calibration", "estimate")
+    rows = [load_rows(dataset, WHEEL_L), load_rows(dataset, BODY)]
+    order = sorted((r[k, 0], i, k) for i, r in enumerate(rows) for k in range(len(r)))
+
+    nav = wheelins.Navigator(manifest, configuration="body-wheel", calibration="estimate", calibration_warmup=1000)
+    for _, i, k in order:
+        assert nav.push(i, rows[i][k][0], rows[i][k][1:4], rows[i][k][4:7])
+    assert not nav.navigating and nav.state is None and nav.calibration is None
+    assert len(nav.trajectory["t_s"]) == 0
+    with pytest.raises(wheelins.InputError, match="warm-up"):
+        nav.covariance(0)
+    nav.finish()
+    same_as_csv(nav.trajectory, read_csv(tmp_path / "all" / "trajectory.csv"))
+    assert nav.calibration == (tmp_path / "all" / "calibration.yaml").read_text()
+
+    static_end = read_csv(tmp_path / "all" / "trajectory.csv")["t_s"][0]  # navigation starts there
+    nav = wheelins.Navigator(manifest, configuration="body-wheel", calibration="estimate", calibration_warmup=15)
+    started = None
+    for _, i, k in order:
+        nav.push(i, rows[i][k][0], rows[i][k][1:4], rows[i][k][4:7])
+        if started is None and nav.navigating:
+            started = rows[i][k][0]
+            # The kept samples are navigated at once: the records from the start are there.
+            t = nav.trajectory["t_s"]
+            assert len(t) > 0 and t[0] == static_end and t[-1] > static_end + 14.9
+    assert started is not None and static_end + 14.99 < started < static_end + 15.02
+    nav.finish()
+    short = wheelins.run(manifest, configuration="body-wheel", calibration="estimate", duration=15,
+                         out=tmp_path / "short")
+    assert nav.calibration_report == short.calibration_report
+    assert "turns" in nav.calibration_report
+    assert nav.trajectory["t_s"][-1] > static_end + 29
+
+    with pytest.raises(wheelins.InputError, match="calibration_warmup"):
+        wheelins.Navigator(manifest, configuration="single", calibration="estimate", calibration_warmup=0)
+    with pytest.raises(wheelins.InputError, match="calibration"):
+        wheelins.Navigator(manifest, configuration="single", calibration="guess")
+
+
 def test_navigator_from_module_specs(dataset, tmp_path):
     """The manifest's content as a dict (no files named) navigates like the manifest file."""
     yaml = pytest.importorskip("yaml")  # python3-yaml, installed by scripts/setup.sh

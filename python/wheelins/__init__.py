@@ -164,6 +164,12 @@ class Navigator:
     increments when the manifest says format: increment). The same samples through the
     same code as `wheelins run` give the same trajectory to the last digit.
 
+    calibration="estimate" (default "manifest": the manifest's geometry as it is) estimates
+    the installation geometry (docs/filter.md section 15) from the first calibration_warmup
+    seconds (default 120) after the static period: their samples are kept, and navigated with
+    the estimates when the warm-up ends (or at finish()), so nothing is output before then;
+    later samples are navigated as they come. The estimates are a run's with that duration.
+
     .state: the vehicle solution now (dict keyed like the trajectory CSV; None before
     navigation starts); .covariance(module): that subsystem's 21x21 error-state
     covariance; .trajectory: the output records so far (dict of numpy arrays).
@@ -226,3 +232,14 @@ class Navigator:
     @property
     def fault_report(self):
         return self._nav.fault_report
+
+    @property
+    def calibration(self):
+        """With calibration="estimate": the warm-up's estimates as calibration.yaml's text
+        (None before the warm-up ends, and with the manifest's geometry)."""
+        return self._nav.calibration
+
+    @property
+    def calibration_report(self):
+        """The same as a readable table (None as .calibration)."""
+        return self._nav.calibration_report

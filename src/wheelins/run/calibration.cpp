@@ -1,6 +1,7 @@
 // The calibration pass of a run (calibration.hpp).
 #include "wheelins/run/calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -11,6 +12,79 @@
 
 namespace wheelins {
 namespace fs = std::filesystem;
+
+struct ModuleCalibrators::Impl {
+  // Per module, in the order of `modules`: one of the two.
+  std::vector<std::unique_ptr<WheelImuCalibrator>> wheel;
+  std::vector<std::unique_ptr<BodyImuCalibrator>> body;
+  InstallationCalibrationOptions opt;
+};
+
+ModuleCalibrators::ModuleCalibrators(const Manifest& m, const std::vector<std::string>& modules,
+                                     const InstallationCalibrationOptions& opt,
+                                     const std::vector<double>& expected_end)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->opt = opt;
+  for (std::size_t k = 0; k < modules.size(); ++k) {
+    const ModuleSpec* spec = m.find(modules[k]);
+    if (!spec) throw InputError("'" + m.path.string() + "': no module '" + modules[k] + "'");
+    const double end = k < expected_end.size() ? expected_end[k] : 0.0;
+    if (spec->kind == ModuleKind::kWheel) {
+      impl_->wheel.push_back(std::make_unique<WheelImuCalibrator>(*spec, m.static_start, m.static_end, opt, end));
+      impl_->body.push_back(nullptr);
+    } else {
+      impl_->wheel.push_back(nullptr);
+      impl_->body.push_back(std::make_unique<BodyImuCalibrator>(*spec, m.static_start, m.static_end, opt));
+    }
+  }
+}
+
+ModuleCalibrators::~ModuleCalibrators() = default;
+ModuleCalibrators::ModuleCalibrators(ModuleCalibrators&&) noexcept = default;
+ModuleCalibrators& ModuleCalibrators::operator=(ModuleCalibrators&&) noexcept = default;
+
+void ModuleCalibrators::add(int index, const ImuSample& s) {
+  const auto k = static_cast<std::size_t>(index);
+  if (impl_->wheel[k])
+    impl_->wheel[k]->add(s);
+  else
+    impl_->body[k]->add(s);
+}
+
+InstallationCalibration ModuleCalibrators::result() const {
+  InstallationCalibration out;
+  std::vector<const WheelImuCalibrator*> views;
+  for (std::size_t k = 0; k < impl_->wheel.size(); ++k) {
+    if (impl_->wheel[k]) {
+      out.wheels.push_back(impl_->wheel[k]->result());
+      views.push_back(impl_->wheel[k].get());
+    } else {
+      out.bodies.push_back(impl_->body[k]->result());
+    }
+  }
+  estimate_relative_radius(views, impl_->opt, out.wheels);
+  return out;
+}
+
+CalibrationWarmup::CalibrationWarmup(const Manifest& m, const std::vector<std::string>& modules,
+                                     const InstallationCalibrationOptions& opt, double warmup_s)
+    : t_end_(m.static_end + warmup_s),
+      cals_(m, modules, opt, std::vector<double>(modules.size(), m.static_end + warmup_s)) {
+  // Room for the warm-up's samples at the modules' rates, so that keeping them does not
+  // reallocate on the way.
+  double per_s = 0.0;
+  for (const auto& name : modules)
+    if (const ModuleSpec* spec = m.find(name)) per_s += spec->rate_hz > 0.0 ? spec->rate_hz : 0.0;
+  const double span = std::max(0.0, t_end_ - std::min(m.static_start, m.static_end));
+  if (std::isfinite(span) && per_s * span < 5e7) kept_.reserve(static_cast<std::size_t>(per_s * span * 1.02) + 16);
+}
+
+bool CalibrationWarmup::add(int index, const ImuSample& s) {
+  if (s.t > t_end_) return false;
+  cals_.add(index, s);
+  kept_.push_back({index, s});
+  return true;
+}
 
 InstallationCalibration calibrate_installation(
     const Manifest& m, const std::vector<std::string>& modules,
@@ -24,49 +98,35 @@ InstallationCalibration calibrate_installation(
   };
   std::uint64_t total = 0;
   std::vector<const ModuleSpec*> specs;
+  std::vector<double> expected_end;
   for (const auto& name : modules) {
     const ModuleSpec* spec = m.find(name);
     if (!spec) throw InputError("'" + m.path.string() + "': no module '" + name + "'");
     specs.push_back(spec);
-    total += binary_samples(*spec);
+    const std::uint64_t n = binary_samples(*spec);
+    total += n;
+    // The rate series reserved for the file's span (binary files: from the sample count).
+    double end = t_end;
+    if (!std::isfinite(end)) end = n > 0 && spec->rate_hz > 0.0 ? m.static_start + static_cast<double>(n) / spec->rate_hz : 0.0;
+    expected_end.push_back(end);
   }
-  InstallationCalibration out;
-  std::vector<std::unique_ptr<WheelImuCalibrator>> wheels;
+  ModuleCalibrators cals(m, modules, opt, expected_end);
   Progress bar("calibrating", total, progress);
   std::uint64_t done = 0;
-  for (const ModuleSpec* spec : specs) {
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    const ModuleSpec* spec = specs[k];
     // The samples the navigator will see: the same reader and input checks, with their
     // warnings left to the navigation pass (which reads the same file again).
     auto reader = std::make_unique<ImuFileReader>(m.resolve(spec->file), imu_read_options(*spec, {}));
     CheckedStream stream(std::move(reader), *spec, m, isolate_faults, WarningSink{});
-    auto feed = [&](auto& cal) {
-      ImuSample s;
-      while (stream.next(s) && s.t <= t_end) {
-        cal.add(s);
-        if ((++done & 0xFFFF) == 0) bar.update(done);
-      }
-    };
-    if (spec->kind == ModuleKind::kWheel) {
-      // The rate series reserved for the file's span (binary files: from the sample count).
-      double expected_end = t_end;
-      const std::uint64_t n = binary_samples(*spec);
-      if (!std::isfinite(expected_end) && n > 0 && spec->rate_hz > 0.0)
-        expected_end = m.static_start + static_cast<double>(n) / spec->rate_hz;
-      auto cal = std::make_unique<WheelImuCalibrator>(*spec, m.static_start, m.static_end, opt, expected_end);
-      feed(*cal);
-      out.wheels.push_back(cal->result());
-      wheels.push_back(std::move(cal));
-    } else {
-      BodyImuCalibrator cal(*spec, m.static_start, m.static_end, opt);
-      feed(cal);
-      out.bodies.push_back(cal.result());
+    ImuSample s;
+    while (stream.next(s) && s.t <= t_end) {
+      cals.add(static_cast<int>(k), s);
+      if ((++done & 0xFFFF) == 0) bar.update(done);
     }
   }
   bar.finish();
-  std::vector<const WheelImuCalibrator*> views;
-  for (const auto& c : wheels) views.push_back(c.get());
-  estimate_relative_radius(views, opt, out.wheels);
-  return out;
+  return cals.result();
 }
 
 Manifest apply_calibration(Manifest m, const InstallationCalibration& cal) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,56 @@ struct InstallationCalibration {
   std::vector<WheelImuCalibration> wheels;  ///< in the order of the run's modules
   std::vector<BodyImuCalibration> bodies;
   bool empty() const { return wheels.empty() && bodies.empty(); }
+};
+
+/// The estimators of a run's modules (a WheelImuCalibrator per Wheel-IMU, a
+/// BodyImuCalibrator per Body-IMU), fed sample by sample.
+class ModuleCalibrators {
+ public:
+  /// `expected_end`: per module, the time of its last sample if known (0: unknown; the
+  /// relative-radius series is reserved up to it). Throws InputError for an unknown name.
+  ModuleCalibrators(const Manifest& m, const std::vector<std::string>& modules,
+                    const InstallationCalibrationOptions& opt, const std::vector<double>& expected_end = {});
+  ~ModuleCalibrators();
+  ModuleCalibrators(ModuleCalibrators&&) noexcept;
+  ModuleCalibrators& operator=(ModuleCalibrators&&) noexcept;
+  /// One sample of module `index` (its position in `modules`; sensor axes, as checked input).
+  void add(int index, const ImuSample& s);
+  /// The estimates from the samples so far, the relative radius included.
+  InstallationCalibration result() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The calibration of a stream that is seen once (the Python Navigator): the samples up to
+/// `static_end + warmup_s` are kept and fed to the estimators; at the first sample after that
+/// (or at the end of the data) the caller takes result() and navigates the kept samples with
+/// it, then the rest as they come. The estimates are calibrate_installation()'s with
+/// t_end = static_end + warmup_s, from the same samples.
+class CalibrationWarmup {
+ public:
+  CalibrationWarmup(const Manifest& m, const std::vector<std::string>& modules,
+                    const InstallationCalibrationOptions& opt, double warmup_s);
+  /// The last time the estimators take [s].
+  double end() const { return t_end_; }
+  /// Keeps sample `s` of module `index`; false (nothing kept) when it is past end().
+  bool add(int index, const ImuSample& s);
+  InstallationCalibration result() const { return cals_.result(); }
+  struct Kept {
+    int index;
+    ImuSample sample;
+  };
+  /// The kept samples in the order given.
+  const std::vector<Kept>& kept() const { return kept_; }
+  /// Frees the kept samples.
+  void release() { std::vector<Kept>().swap(kept_); }
+
+ private:
+  double t_end_;
+  ModuleCalibrators cals_;
+  std::vector<Kept> kept_;
 };
 
 /// Reads the modules among `modules` and returns their estimates (Wheel-IMUs: axle, lever
