@@ -318,7 +318,9 @@ class StreamNavigator {
                               InputChecks(*spec, req_.manifest, req_.nav.faults.enabled, stderr_sink(),
                                           "module '" + name + "' (pushed samples)")});
     }
-    if (!warmup_) make_navigator(req_.manifest);
+    // Built now in any case, so that every setting is checked here; with a warm-up it is built
+    // again, on the estimates, when the warm-up ends.
+    make_navigator(req_.manifest);
   }
 
   /// The navigator, on the manifest (refined by the warm-up's estimates, if any).
@@ -390,7 +392,7 @@ class StreamNavigator {
     // The run's input checks (run/input_checks.hpp): a sample beyond the sensor range is
     // left out (its interval goes to the next one), the rate, format and static period checked.
     if (!tr.checks.admit(s, index)) return !stopped_;
-    if (warmup_ && !nav_) {
+    if (in_warmup()) {
       if (warmup_->add(i, s)) return true;
       end_warmup();
       if (stopped_) return false;
@@ -408,6 +410,7 @@ class StreamNavigator {
       if (stopped_) break;
     }
     warmup_->release();
+    warmup_done_ = true;
   }
 
   void navigate(int i, const ImuSample& s) {
@@ -422,7 +425,7 @@ class StreamNavigator {
   void finish() {
     if (finished_) return;
     for (auto& tr : tracks_) tr.checks.finish();
-    if (!nav_) end_warmup();  // the data ended inside the warm-up: estimates from all of it
+    if (in_warmup()) end_warmup();  // the data ended inside the warm-up: estimates from all of it
     if (!nav_->navigating()) {
       char period[96];
       std::snprintf(period, sizeof period, "[%.3f, %.3f] s", req_.manifest.static_start, req_.manifest.static_end);
@@ -446,7 +449,7 @@ class StreamNavigator {
 
   py::array_t<double> covariance(const py::object& module) const {
     const int i = index_of(module);
-    if (!nav_) throw InputError("no covariance during the calibration warm-up (it ends at t = " +
+    if (in_warmup()) throw InputError("no covariance during the calibration warm-up (it ends at t = " +
                                 io_detail::format_double(warmup_->end()) + " s)");
     if (!nav_->navigating()) throw InputError("no covariance before navigation starts (the static period)");
     if (req_.nav.fusion.centralized)
@@ -460,21 +463,19 @@ class StreamNavigator {
   }
 
   const std::vector<std::string>& modules() const { return req_.modules; }
-  bool navigating() const { return nav_ && nav_->navigating(); }
+  bool navigating() const { return nav_->navigating(); }
   py::array_t<double> records() const { return table(records_); }
   std::size_t record_count() const { return records_.size(); }
-  py::dict stats() const { return stats_dict(nav_ ? nav_->stats() : NavigatorStats{}); }
-  std::string fault_report() const {
-    return nav_ ? fault_report_text(nav_->faults()) : std::string("(calibration warm-up: nothing navigated yet)\n");
-  }
+  py::dict stats() const { return stats_dict(nav_->stats()); }
+  std::string fault_report() const { return fault_report_text(nav_->faults()); }
   /// The warm-up's estimates (calibration.yaml's text; None with the manifest's geometry or
   /// during the warm-up).
   py::object calibration() const {
-    if (!warmup_ || !nav_) return py::none();
+    if (!warmup_done_) return py::none();
     return py::str(calibration_yaml(calibration_, req_.manifest));
   }
   py::object calibration_report() const {
-    if (!warmup_ || !nav_) return py::none();
+    if (!warmup_done_) return py::none();
     return py::str(wheelins::calibration_report(calibration_));
   }
 
@@ -488,7 +489,9 @@ class StreamNavigator {
   RunRequest req_;
   std::vector<Track> tracks_;
   std::unique_ptr<Navigator> nav_;
-  std::unique_ptr<CalibrationWarmup> warmup_;  ///< calibration "estimate": until its end
+  std::unique_ptr<CalibrationWarmup> warmup_;  ///< calibration "estimate"
+  bool warmup_done_ = false;
+  bool in_warmup() const { return warmup_ && !warmup_done_; }
   InstallationCalibration calibration_;
   std::vector<TrajectoryRecord> records_;
   double last_t_ = -std::numeric_limits<double>::infinity();

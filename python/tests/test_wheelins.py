@@ -212,7 +212,8 @@ def test_streaming_navigator_estimates_the_geometry_over_a_warmup(dataset, tmp_p
     for _, i, k in order:
         assert nav.push(i, rows[i][k][0], rows[i][k][1:4], rows[i][k][4:7])
     assert not nav.navigating and nav.state is None and nav.calibration is None
-    assert len(nav.trajectory["t_s"]) == 0
+    assert len(nav.trajectory["t_s"]) == 0 and nav.calibration_report is None
+    assert isinstance(nav.stats, dict) and isinstance(nav.fault_report, str)
     with pytest.raises(wheelins.InputError, match="warm-up"):
         nav.covariance(0)
     nav.finish()
