@@ -52,6 +52,25 @@ TEST(JointCovarianceCondition, TheMeanYawScaleFactorIsHeldAndTheDifferencesStay)
   EXPECT_EQ(joint->block(1), before) << "the mean's variance is below the floor already";
 }
 
+TEST(JointCovarianceCondition, TheCommonYawScaleFactorWeighsEachImuByItsPriorVariance) {
+  // Two Wheel-IMUs (their yaw-rate scale factor the mean of two axes: half the variance of
+  // one) and a Body-IMU (one axis), equal figures: 0.4, 0.4, 0.2, the mean of least variance.
+  const double p = 1e-6;
+  auto w = inverse_variance_weights({p / 2, p / 2, p}, 3);
+  EXPECT_NEAR(w[0], 0.4, 1e-12);
+  EXPECT_NEAR(w[1], 0.4, 1e-12);
+  EXPECT_NEAR(w[2], 0.2, 1e-12);
+  EXPECT_EQ(w[3], 0.0);
+  // A chip with three times the scale-factor figure counts a ninth; one without such states
+  // (a Wheel-INS not estimating them) none.
+  w = inverse_variance_weights({p / 2, 9 * p / 2, 0.0}, 3);
+  EXPECT_NEAR(w[0], 0.9, 1e-12);
+  EXPECT_NEAR(w[1], 0.1, 1e-12);
+  EXPECT_EQ(w[2], 0.0);
+  w = inverse_variance_weights({0.0, 0.0}, 2);
+  EXPECT_EQ(w[0] + w[1], 0.0);
+}
+
 TEST(ReferenceWeights, VarianceOfTheReferencePointIsItsHorizontalTrace) {
   // o = r_b + a heading lever: H has I in the position block and a column in phi_z.
   ReferencePointModel r;

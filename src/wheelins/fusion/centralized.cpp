@@ -142,6 +142,40 @@ void CentralizedFilter::start() {
     joint_->set_block(i, subs_[i].ekf().covariance());
     joint_->set_consider(i, subs_[i].ekf());
   }
+  // The common yaw-rate scale factor that the velocity updates hold (docs/filter.md 13.4):
+  // the mean over the subsystems of each one's yaw-rate scale factor (the mean of its states
+  // estimated from the constraint), weighted by the inverse of its prior variance. Nothing
+  // observes it, so every heading ends up turning with its true value: of all weighted means,
+  // this one has the least variance (a Wheel-IMU's, the mean of two axes, half a Body-IMU's
+  // single axis with equal figures).
+  std::array<double, kMaxCentralized> var{};
+  for (int j = 0; j < subs_.size(); ++j) {
+    const Subsystem& s = subs_[j];
+    const int n = s.yaw_scale_factor_state_count();
+    if (s.yaw_scale_factor_mode() != YawScaleFactors::kFromConstraint || n == 0) continue;
+    const Mat21& P0 = s.ekf().covariance();
+    for (int k = 0; k < n; ++k) var[j] += P0(s.yaw_scale_factor_states()[k], s.yaw_scale_factor_states()[k]);
+    var[j] /= static_cast<double>(n) * n;
+  }
+  const std::array<double, kMaxCentralized> w = inverse_variance_weights(var, subs_.size());
+  holds_common_yaw_ = false;
+  for (int j = 0; j < subs_.size(); ++j) {
+    common_yaw_[j].setZero();
+    const Subsystem& s = subs_[j];
+    for (int k = 0; k < s.yaw_scale_factor_state_count() && w[j] > 0.0; ++k)
+      common_yaw_[j](s.yaw_scale_factor_states()[k]) = w[j] / s.yaw_scale_factor_state_count();
+    holds_common_yaw_ = holds_common_yaw_ || w[j] > 0.0;
+  }
+}
+
+std::array<double, kMaxCentralized> inverse_variance_weights(const std::array<double, kMaxCentralized>& var, int n) {
+  std::array<double, kMaxCentralized> w{};
+  double total = 0.0;
+  for (int j = 0; j < n; ++j)
+    if (var[j] > 0.0) total += (w[j] = 1.0 / var[j]);
+  if (total > 0.0)
+    for (int j = 0; j < n; ++j) w[j] /= total;
+  return w;
 }
 
 void CentralizedFilter::propagate_joint(int i) {
@@ -184,23 +218,12 @@ UpdateReport CentralizedFilter::fuse(const Measurement& m) {
 }
 
 void CentralizedFilter::hold_common_yaw_scale_factor() {
-  // The weighted mean of the subsystems' yaw-rate scale factors (those estimated from the
-  // constraint), what the vehicle heading's own scale factor is: nothing observes it, and in
-  // the joint covariance its variance lets the velocity updates of every stop and start turn
-  // all headings together (docs/filter.md 13.4). Conditioned out before each velocity update
-  // (its Gauss-Markov driving noise brings a little back in between); their differences stay.
-  std::array<Eigen::Matrix<double, 1, kStateDim>, kMaxCentralized> h{};
-  bool any = false;
-  for (int j = 0; j < subs_.size(); ++j) {
-    h[j].setZero();
-    const Subsystem& s = subs_[j];
-    if (s.yaw_scale_factor_mode() != YawScaleFactors::kFromConstraint) continue;
-    const auto& states = s.yaw_scale_factor_states();
-    for (int k = 0; k < s.yaw_scale_factor_state_count(); ++k)
-      h[j](states[k]) = subs_.weight(j) / s.yaw_scale_factor_state_count();
-    any = true;
-  }
-  if (any) joint_->condition(h);
+  // The common yaw-rate scale factor of start(), what the vehicle heading's own scale factor
+  // is: nothing observes it, and in the joint covariance its variance lets the velocity
+  // updates of every stop and start turn all headings together (docs/filter.md 13.4).
+  // Conditioned out before each velocity update (its Gauss-Markov driving noise brings a
+  // little back in between); the differences between the subsystems stay.
+  if (holds_common_yaw_) joint_->condition(common_yaw_);
 }
 
 void CentralizedFilter::restarted(int i) {

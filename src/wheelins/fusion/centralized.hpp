@@ -47,6 +47,12 @@ class JointCovariance {
                               const std::array<const Vec21*, kMaxCentralized>* gain_mask) = 0;
 };
 
+/// The weights of a mean of n quantities of variances var[j] with the least variance:
+/// 1 / var[j], normalised to a sum of 1 (a quantity with no positive variance gets 0; all zero
+/// if none has one). The common yaw-rate scale factor of the centralized filter (docs/filter.md
+/// 13.4).
+std::array<double, kMaxCentralized> inverse_variance_weights(const std::array<double, kMaxCentralized>& var, int n);
+
 /// A joint covariance for n subsystems (2 <= n <= kMaxCentralized); InputError otherwise.
 std::unique_ptr<JointCovariance> make_joint_covariance(int n);
 
@@ -73,6 +79,9 @@ class CentralizedFilter final : public FilterBackend {
   void hold_common_yaw_scale_factor();
   Subsystems& subs_;
   std::unique_ptr<JointCovariance> joint_;
+  /// That mean, set at start() from the subsystems' prior covariances (docs/filter.md 13.4).
+  std::array<Eigen::Matrix<double, 1, kStateDim>, kMaxCentralized> common_yaw_{};
+  bool holds_common_yaw_ = false;
 };
 
 }  // namespace wheelins
