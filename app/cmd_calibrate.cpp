@@ -1,5 +1,5 @@
 // `wheelins calibrate`: refines a manifest's installation geometry (each Wheel-IMU's axle
-// direction, lever arm and relative radius, each Body-IMU's roll and pitch) from a
+// direction, lever arm and relative radius, each Body-IMU's mounting) from a
 // recording, and writes the refined manifest and the estimates with their 1 sigma
 // (docs/filter.md section 15).
 #include <cmath>
@@ -80,7 +80,7 @@ int run(const Options& o) {
         !c.lever_arm[2].observed || !c.wheel_radius.observed)
       ++unobserved;
   for (const auto& c : cal.bodies)
-    if (!c.tilt_x.observed || !c.tilt_y.observed) ++unobserved;
+    if (!c.tilt_x.observed || !c.tilt_y.observed || !c.yaw.observed) ++unobserved;
   // Both files written in full before either is moved into place.
   for (const fs::path& f : {out, report})
     if (f.has_parent_path()) fs::create_directories(f.parent_path());

@@ -264,6 +264,17 @@ TEST(InstallationCalibration, ResidualsTenTimesTheProfilesReachTheTruthWithinThr
   for (int i = 0; i < 2; ++i) worst = std::max(worst, (sim.module(i).manifest.lever_arm_inB - sim.module(i).truth.lever_arm_inB).norm());
   EXPECT_GT(worst, 0.02);
   expect_wheels_reach_the_truth(dir, sim);
+  // The Body-IMU's yaw from a manifest degrees off.
+  const Manifest m = load_manifest(dir / "manifest.yaml", {});
+  const auto body = calibrate_installation(m, configuration_modules(m, "body-wheel", {}), {}, true, false).bodies;
+  ASSERT_EQ(body.size(), 1u);
+  const sim::ModuleModel& g = sim.module(2);
+  const double yaw_left = (dcm_from_euler(body[0].mounting_rpy) * dcm_from_euler(g.truth.mounting_rpy).transpose())(1, 0);
+  const double yaw_before = (dcm_from_euler(g.manifest.mounting_rpy) * dcm_from_euler(g.truth.mounting_rpy).transpose())(1, 0);
+  ASSERT_TRUE(body[0].yaw.observed);
+  EXPECT_LT(std::abs(yaw_left), 3.0 * body[0].yaw.std) << yaw_left / kDeg;
+  EXPECT_GT(std::abs(yaw_before), 0.5 * kDeg);
+  EXPECT_LT(std::abs(yaw_left), 0.33 * std::abs(yaw_before)) << yaw_left / kDeg << " vs " << yaw_before / kDeg;
   std::error_code ec;
   fs::remove_all(dir, ec);
 }
@@ -295,7 +306,7 @@ TEST_F(SimulatedCalibration, RelativeRadiusReachesTheTruthWithinThreeSigma) {
   EXPECT_EQ(one[0].wheel_radius.value, m.find(cal[0].module)->wheel_radius);
 }
 
-TEST_F(SimulatedCalibration, BodyImuRollAndPitchReachTheTruthWithinThreeSigma) {
+TEST_F(SimulatedCalibration, BodyImuMountingReachesTheTruthWithinThreeSigma) {
   const Manifest m = load_manifest(*dir_ / "manifest.yaml", {});
   const auto cal = calibrate_installation(m, configuration_modules(m, "body-wheel", {}), {}, true, false);
   ASSERT_EQ(cal.bodies.size(), 1u);
@@ -311,8 +322,18 @@ TEST_F(SimulatedCalibration, BodyImuRollAndPitchReachTheTruthWithinThreeSigma) {
   EXPECT_LT(std::abs(z.y()), 3.0 * c.tilt_x.std) << z.transpose();
   EXPECT_LT(std::abs(z.x()), 3.0 * c.tilt_y.std) << z.transpose();
   EXPECT_LT(std::hypot(z.x(), z.y()), 0.2 * std::hypot(z0.x(), z0.y()));
-  // The yaw is the manifest's.
-  EXPECT_NEAR(c.mounting_rpy.z(), g.manifest.mounting_rpy.z(), 0.01 * kDeg);
+  // The yaw, from the lateral specific force against the wheel's axle accelerometer: what is
+  // left of M is a rotation about v z.
+  ASSERT_TRUE(c.yaw.observed);
+  EXPECT_LT(std::abs(M(1, 0)), 3.0 * c.yaw.std) << M(1, 0) / kDeg << " deg, sigma " << c.yaw.std / kDeg;
+  // Without a Wheel-IMU in the run nothing reads the lateral force independently: the
+  // manifest's yaw, not observed.
+  const auto alone = calibrate_installation(m, {c.module}, {}, true, false);
+  ASSERT_EQ(alone.bodies.size(), 1u);
+  EXPECT_FALSE(alone.bodies[0].yaw.observed);
+  EXPECT_DOUBLE_EQ(alone.bodies[0].yaw.value, 0.0);
+  EXPECT_NEAR(alone.bodies[0].mounting_rpy.z(), g.manifest.mounting_rpy.z(), 1e-5);
+  EXPECT_TRUE(alone.bodies[0].tilt_x.observed);  // roll and pitch need no wheel
 }
 
 TEST_F(SimulatedCalibration, TheRunUsesTheEstimatesAndWritesThem) {
@@ -404,7 +425,8 @@ TEST_F(SimulatedCalibration, CalibrateCommandWritesARefinedManifestAndNeverTheIn
   EXPECT_NE(onto_input.code, 0);
   EXPECT_NE(onto_input.err.find("input manifest"), std::string::npos) << onto_input.err;
   EXPECT_EQ(slurp(input), before);
-  // A Body-IMU gets its roll and pitch from the turns; its yaw stays the manifest's.
+  // A Body-IMU alone gets its roll and pitch from the turns; its yaw stays the manifest's
+  // (it needs a Wheel-IMU in the run).
   const fs::path body_out = scratch / "b.yaml";
   const Cmd body = run_cli("calibrate -q -m '" + input.string() + "' --modules body-C1 --out '" +
                                body_out.string() + "'",

@@ -42,6 +42,22 @@ CalibratedValue with_prior(double prior, double prior_std, double data, double d
   return v;
 }
 
+/// The index of the rate-series bin a sample falls in (bins of `bin_s` from the static
+/// period's end, by the sample's mid-time); -1 before the first bin or without bins.
+std::ptrdiff_t rate_bin_index(const ImuSample& s, double static_end, double bin_s) {
+  if (!(bin_s > 0.0)) return -1;
+  const double k = std::floor((s.t - 0.5 * s.dt - static_end) / bin_s);
+  return k >= 0.0 && k < 1e8 ? static_cast<std::ptrdiff_t>(k) : -1;
+}
+
+/// Room for the bins up to `expected_end`.
+template <class Bin>
+void reserve_bins(std::vector<Bin>& bins, double static_end, double expected_end, double bin_s) {
+  const double span = expected_end - static_end;
+  if (std::isfinite(span) && span > 0.0 && bin_s > 0.0)
+    bins.reserve(static_cast<std::size_t>(std::min(span / bin_s, 1e8)) + 2);
+}
+
 }  // namespace
 
 WheelImuCalibrator::WheelImuCalibrator(const ImuModule& module, double static_start,
@@ -51,9 +67,8 @@ WheelImuCalibrator::WheelImuCalibrator(const ImuModule& module, double static_st
       opt_(opt),
       C_StoB_(dcm_from_euler(module.mounting_rpy)),
       static_{static_start, static_end} {
-  const double span = expected_end - static_end;
-  if (std::isfinite(span) && span > 0.0 && opt_.rate_bin_s > 0.0)
-    bins_.reserve(static_cast<std::size_t>(std::min(span / opt_.rate_bin_s, 1e8)) + 2);
+  reserve_bins(bins_, static_end, expected_end, opt_.rate_bin_s);
+  reserve_bins(axle_bins_, static_end, expected_end, opt_.yaw_bin_s);
 }
 
 void WheelImuCalibrator::add(const ImuSample& s) {
@@ -65,10 +80,17 @@ void WheelImuCalibrator::add(const ImuSample& s) {
   const Vec3 f = C_StoB_ * (s.dvel / s.dt);
   const double wx = w.x();
   wheel_angle_ = std::fmod(wheel_angle_ + wx * s.dt, kTurn);
-  if (s.dt <= kMaxGap && opt_.rate_bin_s > 0.0) {
+  if (s.dt <= kMaxGap) {
+    const std::ptrdiff_t j = rate_bin_index(s, static_.end, opt_.yaw_bin_s);
+    if (j >= 0) {  // the series of estimate_body_yaw()
+      const auto i = static_cast<std::size_t>(j);
+      if (i >= axle_bins_.size()) axle_bins_.resize(i + 1);
+      axle_bins_[i].dt += s.dt;
+      axle_bins_[i].f += f * s.dt;
+    }
     // The rate series (RateBin::yaw_rate()).
-    const double k = std::floor((s.t - 0.5 * s.dt - static_.end) / opt_.rate_bin_s);
-    if (k >= 0.0 && k < 1e8) {
+    const std::ptrdiff_t k = rate_bin_index(s, static_.end, opt_.rate_bin_s);
+    if (k >= 0) {
       const auto i = static_cast<std::size_t>(k);
       if (i >= bins_.size()) bins_.resize(i + 1);
       RateBin& b = bins_[i];
@@ -236,11 +258,13 @@ WheelImuCalibration WheelImuCalibrator::result() const {
 }
 
 BodyImuCalibrator::BodyImuCalibrator(const ImuModule& module, double static_start, double static_end,
-                                     const InstallationCalibrationOptions& opt)
+                                     const InstallationCalibrationOptions& opt, double expected_end)
     : module_(module),
       opt_(opt),
       C_BtoV_(dcm_from_euler(module.mounting_rpy)),
-      static_{static_start, static_end} {}
+      static_{static_start, static_end} {
+  reserve_bins(bins_, static_end, expected_end, opt_.yaw_bin_s);
+}
 
 void BodyImuCalibrator::add(const ImuSample& s) {
   if (!(s.dt > 0.0)) return;
@@ -250,6 +274,15 @@ void BodyImuCalibrator::add(const ImuSample& s) {
   if (chunk_start_ < 0.0) chunk_start_ = s.t;
   const Vec3 bias = static_.gyro_bias();
   const Vec3 w = C_BtoV_ * (s.dtheta / s.dt - bias);
+  const std::ptrdiff_t k = rate_bin_index(s, static_.end, opt_.yaw_bin_s);
+  if (k >= 0) {  // the series of estimate_body_yaw()
+    const auto i = static_cast<std::size_t>(k);
+    if (i >= bins_.size()) bins_.resize(i + 1);
+    BodyBin& b = bins_[i];
+    b.dt += s.dt;
+    b.w += w * s.dt;
+    b.f += C_BtoV_ * s.dvel;
+  }
   const double wz = std::abs(w.z());
   if (wz > opt_.min_yaw_rate) {
     turn_chunk_ += w * w.transpose() * s.dt;
@@ -308,10 +341,132 @@ BodyImuCalibration BodyImuCalibrator::result() const {
   // The rotation that carries the turn axis a onto v z: phi_x = a_y, phi_y = -a_x.
   r.tilt_x = with_prior(0.0, opt_.body_mounting_prior_std, ey, sy, opt_.observed_ratio);
   r.tilt_y = with_prior(0.0, opt_.body_mounting_prior_std, -ex, sx, opt_.observed_ratio);
+  r.yaw = CalibratedValue{0.0, opt_.body_mounting_prior_std, false};
 
   const Mat3 R = dcm_from_rotvec(Vec3(r.tilt_x.value, r.tilt_y.value, 0.0));
   r.mounting_rpy = euler_from_dcm(R * C_BtoV_);
   return r;
+}
+
+void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const WheelImuCalibrator*>& wheels,
+                       const std::vector<WheelImuCalibration>& wheel_results,
+                       const InstallationCalibrationOptions& opt, BodyImuCalibration& r) {
+  const double inf = std::numeric_limits<double>::infinity();
+  r.yaw = CalibratedValue{0.0, opt.body_mounting_prior_std, false};
+  r.manifest_position = body.module().p_inV;
+  r.position_x = CalibratedValue{0.0, inf, false};
+  r.position_y = CalibratedValue{0.0, inf, false};
+  const Mat3 R_tilt = dcm_from_rotvec(Vec3(r.tilt_x.value, r.tilt_y.value, 0.0));
+  const Mat3 C_BtoV = dcm_from_euler(body.module().mounting_rpy);
+  auto finish = [&] { r.mounting_rpy = euler_from_dcm(dcm_from_rotvec(Vec3(0.0, 0.0, r.yaw.value)) * R_tilt * C_BtoV); };
+  const double bin_s = opt.yaw_bin_s;
+  if (wheels.empty() || wheel_results.size() != wheels.size() || !(bin_s > 0.0) || !(opt.chunk_s > 0.0))
+    return finish();
+  std::size_t n = body.bins().size();
+  for (const auto* w : wheels) n = std::min(n, w->axle_bins().size());
+  if (n < 3) return finish();
+
+  // Each Wheel-IMU's axle, the estimated one, as a row in its manifest b-frame, signed to
+  // point along v y; the wheels' mean position.
+  std::vector<Vec3> axle(wheels.size());
+  Vec3 p_wheels = Vec3::Zero();
+  for (std::size_t i = 0; i < wheels.size(); ++i) {
+    const ImuModule& w = wheels[i]->module();
+    const Mat3 R = dcm_from_euler(wheel_results[i].mounting_rpy) * dcm_from_euler(w.mounting_rpy).transpose();
+    axle[i] = w.axle_sign * (R.transpose() * Vec3::UnitX());
+    p_wheels += w.p_inV / static_cast<double>(wheels.size());
+  }
+  const Vec3 dp = body.module().p_inV - p_wheels;  // the manifest's offset
+
+  // Per bin: the Body-IMU's yaw rate and specific force (tilt-corrected v-frame), the
+  // wheels' mean axle specific force.
+  struct Bin {
+    bool ok = false;
+    double yaw_rate = 0.0, f_x = 0.0, f_y = 0.0, f_axle = 0.0;
+  };
+  std::vector<Bin> bins(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const BodyBin& b = body.bins()[k];
+    if (b.dt < 0.9 * bin_s) continue;  // a gap, or the last bin
+    Bin& x = bins[k];
+    x.ok = true;
+    x.yaw_rate = (R_tilt * b.w).z() / b.dt;
+    const Vec3 f = R_tilt * b.f / b.dt;
+    x.f_x = f.x();
+    x.f_y = f.y();
+    for (std::size_t i = 0; i < wheels.size(); ++i) {
+      const AxleBin& wb = wheels[i]->axle_bins()[k];
+      if (wb.dt < 0.9 * bin_s) x.ok = false;
+      else x.f_axle += axle[i].dot(wb.f) / wb.dt / static_cast<double>(wheels.size());
+    }
+  }
+
+  // Least squares with an intercept per chunk: the sums of each chunk, centred.
+  struct Chunk {
+    double n = 0.0, y = 0.0, yy = 0.0;
+    Vec3 x = Vec3::Zero(), xy = Vec3::Zero();
+    Mat3 xx = Mat3::Zero();
+    Mat3 XX() const { return xx - x * x.transpose() / n; }
+    Vec3 XY() const { return xy - x * y / n; }
+    double YY() const { return yy - y * y / n; }
+  };
+  std::vector<Chunk> chunks;
+  for (std::size_t k = 1; k + 1 < n; ++k) {
+    const Bin &b0 = bins[k - 1], &b = bins[k], &b1 = bins[k + 1];
+    if (!b0.ok || !b.ok || !b1.ok) continue;
+    const double yaw_acc = (b1.yaw_rate - b0.yaw_rate) / (2.0 * bin_s);
+    const double w2 = b.yaw_rate * b.yaw_rate;
+    // The lateral specific force the Body-IMU reads beyond the wheels' axles: with the
+    // manifest's offset taken out, delta f_x and the offset's correction are left.
+    const double y = b.f_y - b.f_axle - (yaw_acc * dp.x() - w2 * dp.y());
+    const Vec3 x(b.f_x, yaw_acc, -w2);
+    const auto c = static_cast<std::size_t>(std::floor(static_cast<double>(k) * bin_s / opt.chunk_s));
+    if (c >= chunks.size()) chunks.resize(c + 1);
+    Chunk& ch = chunks[c];
+    ch.n += 1.0;
+    ch.y += y;
+    ch.yy += y * y;
+    ch.x += x;
+    ch.xy += x * y;
+    ch.xx += x * x.transpose();
+  }
+  Mat3 N = Mat3::Zero();
+  Vec3 B = Vec3::Zero();
+  double YY = 0.0, rows = 0.0, used = 0.0;
+  for (const Chunk& ch : chunks) {
+    if (ch.n < 3.0) continue;
+    N += ch.XX();
+    B += ch.XY();
+    YY += ch.YY();
+    rows += ch.n;
+    used += 1.0;
+  }
+  r.yaw_bins = static_cast<int>(rows);
+  const double dof = rows - used - 3.0;
+  if (used < 3.0 || !(dof > 0.0) || !(N(0, 0) > 0.0)) return finish();
+  r.yaw_excitation = std::sqrt(N(0, 0) / rows);
+  const Eigen::LDLT<Mat3> ldlt(N);
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-12)) return finish();
+  const Vec3 theta = ldlt.solve(B);
+  const double s2 = std::max(0.0, YY - theta.dot(B)) / dof;
+  r.yaw_residual_rms = std::sqrt(s2);
+  const Mat3 Ni = ldlt.solve(Mat3::Identity());
+  // Its covariance: least squares (bins taken as independent), and the chunks' scores
+  // (what is correlated between bins: the terrain, vibration, slow biases): the larger.
+  Mat3 G = Mat3::Zero();
+  for (const Chunk& ch : chunks) {
+    if (ch.n < 3.0) continue;
+    const Vec3 g = ch.XY() - ch.XX() * theta;
+    G += g * g.transpose();
+  }
+  const Mat3 cov_chunks = Ni * G * Ni * (used / (used - 1.0));
+  auto sigma = [&](int i) { return std::sqrt(std::max(s2 * Ni(i, i), cov_chunks(i, i))); };
+  // The manifest frame is the true one turned by delta about v z: the correction is -delta.
+  r.yaw = with_prior(0.0, opt.body_mounting_prior_std, -theta(0), sigma(0), opt.observed_ratio);
+  // The position: no prior beyond the manifest's own (reported, not applied).
+  r.position_x = CalibratedValue{theta(1), sigma(1), true};
+  r.position_y = CalibratedValue{theta(2), sigma(2), true};
+  finish();
 }
 
 void estimate_relative_radius(const std::vector<const WheelImuCalibrator*>& cals,

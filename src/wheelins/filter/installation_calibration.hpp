@@ -25,11 +25,14 @@
 //      track psi_dot = r_L w_L - r_R w_R,
 //    fitted for eps_L - eps_R (the radii's relative errors) and a scale of psi_dot.
 //    estimate_relative_radius() combines two sides' series.
+//  * A Body-IMU's mounting: roll and pitch from the axis the vehicle turns about
+//    (BodyImuCalibrator), the yaw from its lateral specific force against the Wheel-IMUs'
+//    axle accelerometers (estimate_body_yaw()).
 // Each estimate is combined with a Gaussian prior around the manifest value; with no
 // information it stays there and says so (observed = false).
 //
-// Per sample: fixed-size arithmetic, no allocation (the rate series is reserved for the
-// expected duration up front).
+// Per sample: fixed-size arithmetic, no allocation (the time-bin series are reserved for
+// the expected duration up front).
 #pragma once
 
 #include <algorithm>
@@ -55,6 +58,7 @@ struct InstallationCalibrationOptions {
   double radius_prior_std = 0.01;         ///< 1 sigma of the manifest radii's ratio [-]
   double body_mounting_prior_std = 1.0 * kDeg;  ///< 1 sigma of a Body-IMU's manifest mounting
   double min_yaw_rate = 0.1;              ///< a Body-IMU counts as turning above this [rad/s]
+  double yaw_bin_s = 0.1;                 ///< time bins of a Body-IMU's yaw fit [s]
 };
 
 /// An estimate with its 1-sigma and whether the data determined it.
@@ -110,6 +114,13 @@ struct RateBin {
   }
 };
 
+/// The specific force of a Wheel-IMU over one time bin of a Body-IMU's yaw fit (bins of
+/// `yaw_bin_s` from the end of the static period).
+struct AxleBin {
+  double dt = 0.0;        ///< sampled time in the bin [s]
+  Vec3 f = Vec3::Zero();  ///< integral of the specific force in the manifest b-frame [m/s]
+};
+
 /// The sums over the static period before the run: its mean rate is the gyro bias, its
 /// mean specific force gravity as the accelerometer reads it.
 struct StaticPeriodSums {
@@ -149,6 +160,7 @@ class WheelImuCalibrator {
   int turns() const { return turns_; }
   const ImuModule& module() const { return module_; }
   const std::vector<RateBin>& rate_bins() const { return bins_; }
+  const std::vector<AxleBin>& axle_bins() const { return axle_bins_; }
   /// |f| over the static period (gravity as this accelerometer reads it) [m/s^2].
   double gravity() const { return static_.gravity(); }
 
@@ -198,6 +210,15 @@ class WheelImuCalibrator {
   // Relative radius: the rate series.
   double wheel_angle_ = 0.0;
   std::vector<RateBin> bins_;
+  std::vector<AxleBin> axle_bins_;  // a Body-IMU's yaw fit
+};
+
+/// Sums over one time bin of a Body-IMU's data (the bins of AxleBin), in the v-frame given
+/// by the manifest mounting.
+struct BodyBin {
+  double dt = 0.0;       ///< sampled time in the bin [s]
+  Vec3 w = Vec3::Zero(); ///< integral of the rate, static-period bias removed [rad]
+  Vec3 f = Vec3::Zero(); ///< integral of the specific force [m/s]
 };
 
 /// A Body-IMU's mounting against the vehicle frame (C_b^v as ZYX Euler angles).
@@ -205,9 +226,19 @@ struct BodyImuCalibration {
   std::string module;
   double turning_time = 0.0;  ///< time spent turning faster than min_yaw_rate [s]
   /// The correction of the vehicle's z-axis (the yaw axis) as seen in the v-frame given by
-  /// the manifest: small rotations about v x and v y [rad]. The mounting yaw is the
-  /// manifest's (not estimated: docs/filter.md section 15).
+  /// the manifest: small rotations about v x and v y [rad].
   CalibratedValue tilt_x, tilt_y;
+  /// The correction of the mounting yaw: a rotation about v z, after the tilt [rad]; from
+  /// the lateral specific force against the Wheel-IMUs' axle accelerometers
+  /// (estimate_body_yaw(); without a Wheel-IMU in the run: the manifest's, not observed).
+  CalibratedValue yaw;
+  /// Fitted with the yaw: the correction of the Body-IMU's position in the v-frame (x, y)
+  /// relative to the mean of the Wheel-IMUs' manifest positions [m]. Reported, not applied.
+  CalibratedValue position_x, position_y;
+  Vec3 manifest_position = Vec3::Zero();  ///< the manifest's position_v_m [m]
+  int yaw_bins = 0;                 ///< time bins used by the yaw fit
+  double yaw_excitation = 0.0;      ///< RMS forward specific force about its chunk means [m/s^2]
+  double yaw_residual_rms = 0.0;    ///< RMS residual of the yaw fit per bin [m/s^2]
   Vec3 mounting_rpy = Vec3::Zero();  ///< with the corrections applied [rad]
   Vec3 manifest_mounting_rpy = Vec3::Zero();
 };
@@ -216,12 +247,17 @@ struct BodyImuCalibration {
 /// the vehicle's z-axis is the axis it turns about. On any ground a vehicle yaws about its
 /// own z, so the principal axis of the rates' scatter while turning is v z in the b-frame
 /// (the terrain's pitch and roll rates are smaller and uncorrelated with the yaw rate).
+/// It also keeps the data in time bins for the yaw (estimate_body_yaw()).
 class BodyImuCalibrator {
  public:
+  /// `expected_end`: as WheelImuCalibrator's (the bin series is reserved up to it).
   BodyImuCalibrator(const ImuModule& module, double static_start, double static_end,
-                    const InstallationCalibrationOptions& opt = {});
+                    const InstallationCalibrationOptions& opt = {}, double expected_end = 0.0);
   void add(const ImuSample& sensor_sample);
+  /// Roll and pitch; the yaw is the manifest's until estimate_body_yaw() sets it.
   BodyImuCalibration result() const;
+  const ImuModule& module() const { return module_; }
+  const std::vector<BodyBin>& bins() const { return bins_; }
 
  private:
   void close_chunk();
@@ -235,7 +271,24 @@ class BodyImuCalibrator {
   double turn_time_ = 0.0, turn_chunk_time_ = 0.0, yaw_sum_ = 0.0;
   Vec3 axis_sum_ = Vec3::Zero(), axis_sq_ = Vec3::Zero();
   int axis_chunks_ = 0;
+  std::vector<BodyBin> bins_;
 };
+
+/// The Body-IMU's mounting yaw (docs/filter.md section 15), from gravity and the NHC: a
+/// Wheel-IMU's accelerometer along its axle (v y) reads the vehicle's lateral specific force
+/// (the lateral acceleration and the ground's bank), which is the Body-IMU's too but for the
+/// rotational terms of their offset. A yaw error delta adds delta times the forward specific
+/// force (the acceleration and the ground's grade) to the Body-IMU's lateral one:
+///   f_y(body) - f_axle(wheels) = delta f_x(body) + psi'' dp_x - psi'^2 dp_y + b,
+/// dp the Body-IMU's position relative to the wheels' mean, b the accelerometer biases,
+/// eliminated per chunk of `chunk_s`. Fitted over time bins of `yaw_bin_s` for delta and
+/// the correction of dp from the manifest's. No wheel speed enters (slip does not bias it).
+/// `wheel_results`: the Wheel-IMUs' estimates (their axles), in the order of `wheels`.
+/// Sets the yaw, the position corrections and `mounting_rpy` of `body_result`; without a
+/// Wheel-IMU, or with too little acceleration, the manifest's yaw is kept (not observed).
+void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const WheelImuCalibrator*>& wheels,
+                       const std::vector<WheelImuCalibration>& wheel_results,
+                       const InstallationCalibrationOptions& opt, BodyImuCalibration& body_result);
 
 /// The relative radius of two sides' Wheel-IMUs from their rate series (module y in the
 /// v-frame tells the sides; more than one module on a side, e.g. several chips on one

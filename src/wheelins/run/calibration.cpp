@@ -34,7 +34,7 @@ ModuleCalibrators::ModuleCalibrators(const Manifest& m, const std::vector<std::s
       impl_->body.push_back(nullptr);
     } else {
       impl_->wheel.push_back(nullptr);
-      impl_->body.push_back(std::make_unique<BodyImuCalibrator>(*spec, m.static_start, m.static_end, opt));
+      impl_->body.push_back(std::make_unique<BodyImuCalibrator>(*spec, m.static_start, m.static_end, opt, end));
     }
   }
 }
@@ -54,15 +54,19 @@ void ModuleCalibrators::add(int index, const ImuSample& s) {
 InstallationCalibration ModuleCalibrators::result() const {
   InstallationCalibration out;
   std::vector<const WheelImuCalibrator*> views;
+  std::vector<const BodyImuCalibrator*> bodies;
   for (std::size_t k = 0; k < impl_->wheel.size(); ++k) {
     if (impl_->wheel[k]) {
       out.wheels.push_back(impl_->wheel[k]->result());
       views.push_back(impl_->wheel[k].get());
     } else {
       out.bodies.push_back(impl_->body[k]->result());
+      bodies.push_back(impl_->body[k].get());
     }
   }
   estimate_relative_radius(views, impl_->opt, out.wheels);
+  // A Body-IMU's yaw from the speed of every Wheel-IMU in the run.
+  for (std::size_t b = 0; b < bodies.size(); ++b) estimate_body_yaw(*bodies[b], views, out.wheels, impl_->opt, out.bodies[b]);
   return out;
 }
 
@@ -202,9 +206,20 @@ std::string calibration_yaml(const InstallationCalibration& cal, const Manifest&
     y += "    turning_s: " + num(c.turning_time, 4) + "  # time turning, which shows the vehicle's z-axis\n";
     y += "    mounting_deg:\n";
     y += "      estimate: " + list3(c.mounting_rpy.x() * d, c.mounting_rpy.y() * d, c.mounting_rpy.z() * d) + "\n";
-    y += "      std: " + list3(c.tilt_x.std * d, c.tilt_y.std * d, 0.0, 3) + "  # of the v-frame about v x and y; yaw: not estimated\n";
+    y += "      std: " + list3(c.tilt_x.std * d, c.tilt_y.std * d, c.yaw.std * d, 3) + "  # of the v-frame about v x, y and z\n";
     y += "      manifest: " + list3(c.manifest_mounting_rpy.x() * d, c.manifest_mounting_rpy.y() * d, c.manifest_mounting_rpy.z() * d) + "\n";
-    y += std::string("      observed: [") + yn(c.tilt_x.observed) + ", " + yn(c.tilt_y.observed) + ", false]\n";
+    y += std::string("      observed: [") + yn(c.tilt_x.observed) + ", " + yn(c.tilt_y.observed) + ", " + yn(c.yaw.observed) + "]\n";
+    y += "    yaw_fit:  # the yaw from the lateral specific force against the Wheel-IMUs' axle accelerometers\n";
+    y += "      bins: " + std::to_string(c.yaw_bins) + "\n";
+    y += "      excitation_m_s2: " + num(c.yaw_excitation, 4) + "  # RMS forward specific force about its 60 s means\n";
+    y += "      residual_rms_m_s2: " + num(c.yaw_residual_rms, 4) + "\n";
+    if (std::isfinite(c.position_x.std) && std::isfinite(c.position_y.std)) {
+      const Vec3 p = c.manifest_position;
+      y += "    position_v_m:  # fitted with the yaw, relative to the Wheel-IMUs' manifest positions; not applied by the run\n";
+      y += "      estimate: " + list3(p.x() + c.position_x.value, p.y() + c.position_y.value, p.z()) + "\n";
+      y += "      std: " + list3(c.position_x.std, c.position_y.std, 0.0, 3) + "  # z: not estimated\n";
+      y += "      manifest: " + list3(p.x(), p.y(), p.z()) + "\n";
+    }
   }
   return y;
 }
@@ -238,12 +253,25 @@ std::string calibration_report(const InstallationCalibration& cal) {
   }
   for (const auto& c : cal.bodies) {
     std::snprintf(line, sizeof line,
-                  "  %-10s body        mounting roll %.3f (%.3f), pitch %.3f (%.3f) deg, z-axis +- %.3f, %.3f deg; "
-                  "yaw %.3f deg (manifest, not estimated)%s\n",
+                  "  %-10s body        mounting roll %.3f (%.3f), pitch %.3f (%.3f) deg, z-axis +- %.3f, %.3f deg%s\n",
                   c.module.c_str(), c.mounting_rpy.x() * d, c.manifest_mounting_rpy.x() * d,
                   c.mounting_rpy.y() * d, c.manifest_mounting_rpy.y() * d, c.tilt_x.std * d, c.tilt_y.std * d,
-                  c.mounting_rpy.z() * d, c.tilt_x.observed && c.tilt_y.observed ? "" : "  (not observed: manifest kept)");
+                  c.tilt_x.observed && c.tilt_y.observed ? "" : "  (not observed: manifest kept)");
     t += line;
+    std::snprintf(line, sizeof line, "  %-10s %5s        mounting yaw %.3f +- %.3f (%.3f) deg%s\n", "", "",
+                  c.mounting_rpy.z() * d, c.yaw.std * d, c.manifest_mounting_rpy.z() * d,
+                  c.yaw.observed ? ""
+                                 : "  (not observed: manifest kept; needs a Wheel-IMU in the run and "
+                                   "acceleration)");
+    t += line;
+    if (std::isfinite(c.position_x.std) && std::isfinite(c.position_y.std)) {
+      std::snprintf(line, sizeof line,
+                    "  %-10s %5s        position x %+.1f +- %.1f, y %+.1f +- %.1f mm from the manifest's "
+                    "(relative to the wheels; not applied)\n",
+                    "", "", c.position_x.value * 1e3, c.position_x.std * 1e3, c.position_y.value * 1e3,
+                    c.position_y.std * 1e3);
+      t += line;
+    }
   }
   return t;
 }
