@@ -80,7 +80,9 @@ int run(const Options& o) {
         !c.lever_arm[2].observed || !c.wheel_radius.observed)
       ++unobserved;
   for (const auto& c : cal.bodies)
-    if (!c.tilt_x.observed || !c.tilt_y.observed || !c.yaw.observed) ++unobserved;
+    if (!c.tilt_x.observed || !c.tilt_y.observed || !c.yaw.observed || !c.position_x.observed ||
+        !c.position_y.observed)
+      ++unobserved;
   // Both files written in full before either is moved into place.
   for (const fs::path& f : {out, report})
     if (f.has_parent_path()) fs::create_directories(f.parent_path());

@@ -326,6 +326,22 @@ TEST_F(SimulatedCalibration, BodyImuMountingReachesTheTruthWithinThreeSigma) {
   // left of M is a rotation about v z.
   ASSERT_TRUE(c.yaw.observed);
   EXPECT_LT(std::abs(M(1, 0)), 3.0 * c.yaw.std) << M(1, 0) / kDeg << " deg, sigma " << c.yaw.std / kDeg;
+  // Fitted with it: the Body-IMU's position relative to the wheels (x, y), whose manifest
+  // error is the body's own less the wheels' mean.
+  auto offset = [&](bool truth) {
+    const auto pos = [&](int i) { return truth ? sim_->module(i).truth.p_inV : sim_->module(i).manifest.p_inV; };
+    return Vec3(pos(2) - 0.5 * (pos(0) + pos(1)));
+  };
+  const Vec3 correction = offset(true) - offset(false);
+  ASSERT_TRUE(c.position_x.observed && c.position_y.observed);
+  EXPECT_LT(std::abs(c.position_x.value - correction.x()), 3.0 * c.position_x.std) << correction.transpose();
+  EXPECT_LT(std::abs(c.position_y.value - correction.y()), 3.0 * c.position_y.std) << correction.transpose();
+  // The refined manifest carries it.
+  const Manifest refined = apply_calibration(m, cal);
+  const Vec3 moved = refined.find(c.module)->p_inV - m.find(c.module)->p_inV;
+  EXPECT_NEAR(moved.x(), c.position_x.value, 1e-12);
+  EXPECT_NEAR(moved.y(), c.position_y.value, 1e-12);
+  EXPECT_EQ(moved.z(), 0.0);
   // Without a Wheel-IMU in the run nothing reads the lateral force independently: the
   // manifest's yaw, not observed.
   const auto alone = calibrate_installation(m, {c.module}, {}, true, false);

@@ -342,6 +342,8 @@ BodyImuCalibration BodyImuCalibrator::result() const {
   r.tilt_x = with_prior(0.0, opt_.body_mounting_prior_std, ey, sy, opt_.observed_ratio);
   r.tilt_y = with_prior(0.0, opt_.body_mounting_prior_std, -ex, sx, opt_.observed_ratio);
   r.yaw = CalibratedValue{0.0, opt_.body_mounting_prior_std, false};
+  r.manifest_position = module_.p_inV;
+  r.position_x = r.position_y = CalibratedValue{0.0, opt_.position_prior_std, false};
 
   const Mat3 R = dcm_from_rotvec(Vec3(r.tilt_x.value, r.tilt_y.value, 0.0));
   r.mounting_rpy = euler_from_dcm(R * C_BtoV_);
@@ -351,11 +353,10 @@ BodyImuCalibration BodyImuCalibrator::result() const {
 void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const WheelImuCalibrator*>& wheels,
                        const std::vector<WheelImuCalibration>& wheel_results,
                        const InstallationCalibrationOptions& opt, BodyImuCalibration& r) {
-  const double inf = std::numeric_limits<double>::infinity();
   r.yaw = CalibratedValue{0.0, opt.body_mounting_prior_std, false};
   r.manifest_position = body.module().p_inV;
-  r.position_x = CalibratedValue{0.0, inf, false};
-  r.position_y = CalibratedValue{0.0, inf, false};
+  r.position_x = CalibratedValue{0.0, opt.position_prior_std, false};
+  r.position_y = CalibratedValue{0.0, opt.position_prior_std, false};
   const Mat3 R_tilt = dcm_from_rotvec(Vec3(r.tilt_x.value, r.tilt_y.value, 0.0));
   const Mat3 C_BtoV = dcm_from_euler(body.module().mounting_rpy);
   auto finish = [&] { r.mounting_rpy = euler_from_dcm(dcm_from_rotvec(Vec3(0.0, 0.0, r.yaw.value)) * R_tilt * C_BtoV); };
@@ -463,9 +464,8 @@ void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const Wh
   auto sigma = [&](int i) { return std::sqrt(std::max(s2 * Ni(i, i), cov_chunks(i, i))); };
   // The manifest frame is the true one turned by delta about v z: the correction is -delta.
   r.yaw = with_prior(0.0, opt.body_mounting_prior_std, -theta(0), sigma(0), opt.observed_ratio);
-  // The position: no prior beyond the manifest's own (reported, not applied).
-  r.position_x = CalibratedValue{theta(1), sigma(1), true};
-  r.position_y = CalibratedValue{theta(2), sigma(2), true};
+  r.position_x = with_prior(0.0, opt.position_prior_std, theta(1), sigma(1), opt.observed_ratio);
+  r.position_y = with_prior(0.0, opt.position_prior_std, theta(2), sigma(2), opt.observed_ratio);
   finish();
 }
 

@@ -57,6 +57,7 @@ struct InstallationCalibrationOptions {
   double rate_bin_s = 1.0;                ///< time bins of the relative-radius fit [s]
   double radius_prior_std = 0.01;         ///< 1 sigma of the manifest radii's ratio [-]
   double body_mounting_prior_std = 1.0 * kDeg;  ///< 1 sigma of a Body-IMU's manifest mounting
+  double position_prior_std = 0.02;       ///< 1 sigma of a Body-IMU's manifest position relative to the wheels [m]
   double min_yaw_rate = 0.1;              ///< a Body-IMU counts as turning above this [rad/s]
   double yaw_bin_s = 0.1;                 ///< time bins of a Body-IMU's yaw fit [s]
 };
@@ -233,7 +234,8 @@ struct BodyImuCalibration {
   /// (estimate_body_yaw(); without a Wheel-IMU in the run: the manifest's, not observed).
   CalibratedValue yaw;
   /// Fitted with the yaw: the correction of the Body-IMU's position in the v-frame (x, y)
-  /// relative to the mean of the Wheel-IMUs' manifest positions [m]. Reported, not applied.
+  /// relative to the mean of the Wheel-IMUs' manifest positions [m], so that the offset
+  /// between them is the true one.
   CalibratedValue position_x, position_y;
   Vec3 manifest_position = Vec3::Zero();  ///< the manifest's position_v_m [m]
   int yaw_bins = 0;                 ///< time bins used by the yaw fit

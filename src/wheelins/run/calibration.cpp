@@ -142,7 +142,11 @@ Manifest apply_calibration(Manifest m, const InstallationCalibration& cal) {
         spec.wheel_radius = c.wheel_radius.value;
       }
     for (const auto& c : cal.bodies)
-      if (spec.name == c.module) spec.mounting_rpy = c.mounting_rpy;
+      if (spec.name == c.module) {
+        spec.mounting_rpy = c.mounting_rpy;
+        spec.p_inV.x() += c.position_x.value;
+        spec.p_inV.y() += c.position_y.value;
+      }
   }
   return m;
 }
@@ -213,13 +217,12 @@ std::string calibration_yaml(const InstallationCalibration& cal, const Manifest&
     y += "      bins: " + std::to_string(c.yaw_bins) + "\n";
     y += "      excitation_m_s2: " + num(c.yaw_excitation, 4) + "  # RMS forward specific force about its 60 s means\n";
     y += "      residual_rms_m_s2: " + num(c.yaw_residual_rms, 4) + "\n";
-    if (std::isfinite(c.position_x.std) && std::isfinite(c.position_y.std)) {
-      const Vec3 p = c.manifest_position;
-      y += "    position_v_m:  # fitted with the yaw, relative to the Wheel-IMUs' manifest positions; not applied by the run\n";
-      y += "      estimate: " + list3(p.x() + c.position_x.value, p.y() + c.position_y.value, p.z()) + "\n";
-      y += "      std: " + list3(c.position_x.std, c.position_y.std, 0.0, 3) + "  # z: not estimated\n";
-      y += "      manifest: " + list3(p.x(), p.y(), p.z()) + "\n";
-    }
+    const Vec3 p = c.manifest_position;
+    y += "    position_v_m:  # x, y fitted with the yaw, relative to the Wheel-IMUs' manifest positions\n";
+    y += "      estimate: " + list3(p.x() + c.position_x.value, p.y() + c.position_y.value, p.z()) + "\n";
+    y += "      std: " + list3(c.position_x.std, c.position_y.std, 0.0, 3) + "  # z: not estimated\n";
+    y += "      manifest: " + list3(p.x(), p.y(), p.z()) + "\n";
+    y += std::string("      observed: [") + yn(c.position_x.observed) + ", " + yn(c.position_y.observed) + ", false]\n";
   }
   return y;
 }
@@ -264,14 +267,13 @@ std::string calibration_report(const InstallationCalibration& cal) {
                                  : "  (not observed: manifest kept; needs a Wheel-IMU in the run and "
                                    "acceleration)");
     t += line;
-    if (std::isfinite(c.position_x.std) && std::isfinite(c.position_y.std)) {
-      std::snprintf(line, sizeof line,
-                    "  %-10s %5s        position x %+.1f +- %.1f, y %+.1f +- %.1f mm from the manifest's "
-                    "(relative to the wheels; not applied)\n",
-                    "", "", c.position_x.value * 1e3, c.position_x.std * 1e3, c.position_y.value * 1e3,
-                    c.position_y.std * 1e3);
-      t += line;
-    }
+    std::snprintf(line, sizeof line,
+                  "  %-10s %5s        position x %+.1f +- %.1f, y %+.1f +- %.1f mm from the manifest's "
+                  "(relative to the wheels)%s\n",
+                  "", "", c.position_x.value * 1e3, c.position_x.std * 1e3, c.position_y.value * 1e3,
+                  c.position_y.std * 1e3,
+                  c.position_x.observed && c.position_y.observed ? "" : "  (not observed: manifest kept)");
+    t += line;
   }
   return t;
 }
