@@ -349,6 +349,8 @@ TEST_F(SimulatedCalibration, BodyImuMountingReachesTheTruthWithinThreeSigma) {
   EXPECT_FALSE(alone.bodies[0].yaw.observed);
   EXPECT_DOUBLE_EQ(alone.bodies[0].yaw.value, 0.0);
   EXPECT_NEAR(alone.bodies[0].mounting_rpy.z(), g.manifest.mounting_rpy.z(), 1e-5);
+  EXPECT_FALSE(alone.bodies[0].position_x.observed || alone.bodies[0].position_y.observed);
+  EXPECT_EQ(apply_calibration(m, alone).find(c.module)->p_inV, m.find(c.module)->p_inV);
   EXPECT_TRUE(alone.bodies[0].tilt_x.observed);  // roll and pitch need no wheel
 }
 

@@ -276,7 +276,8 @@ class BodyImuCalibrator {
   std::vector<BodyBin> bins_;
 };
 
-/// The Body-IMU's mounting yaw (docs/filter.md section 15), from gravity and the NHC: a
+/// The Body-IMU's mounting yaw (docs/filter.md section 15), from the specific force (gravity
+/// included) that it shares with the wheels' axles, not from the NHC (see there): a
 /// Wheel-IMU's accelerometer along its axle (v y) reads the vehicle's lateral specific force
 /// (the lateral acceleration and the ground's bank), which is the Body-IMU's too but for the
 /// rotational terms of their offset. A yaw error delta adds delta times the forward specific

@@ -65,7 +65,7 @@ InstallationCalibration ModuleCalibrators::result() const {
     }
   }
   estimate_relative_radius(views, impl_->opt, out.wheels);
-  // A Body-IMU's yaw from the speed of every Wheel-IMU in the run.
+  // A Body-IMU's yaw (and position) against the axle accelerometers of every Wheel-IMU in the run.
   for (std::size_t b = 0; b < bodies.size(); ++b) estimate_body_yaw(*bodies[b], views, out.wheels, impl_->opt, out.bodies[b]);
   return out;
 }
