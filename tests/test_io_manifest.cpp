@@ -175,6 +175,47 @@ TEST(IoManifest, RoundTripOfArbitrarySiValues) {
   }
 }
 
+TEST(IoManifest, WithoutAnInitialHeadingTheRunStartsInALocalFrame) {
+  ScratchDir dir;
+  std::string text = kMinimal;
+  text.replace(text.find(", heading_deg: 90"), 17, "");
+  write_text(dir / "m.yaml", text);
+  const Manifest m = load_manifest(dir / "m.yaml", kQuiet);
+  EXPECT_FALSE(m.heading_known);
+  EXPECT_EQ(m.initial_heading, 0.0);
+  EXPECT_FALSE(vehicle_setup(m).heading_known);
+  // Saved and read back: still no heading (none is invented).
+  save_manifest(m, dir / "m2.yaml");
+  EXPECT_EQ(read_text_file(dir / "m2.yaml").find("heading_deg"), std::string::npos);
+  EXPECT_FALSE(load_manifest(dir / "m2.yaml", kQuiet).heading_known);
+  write_text(dir / "m.yaml", kMinimal);
+  EXPECT_TRUE(load_manifest(dir / "m.yaml", kQuiet).heading_known);
+}
+
+TEST(IoManifest, AxleAxisAntennaWheelbaseAndTruthOffsetRoundTrip) {
+  ScratchDir dir;
+  std::string text = kMinimal;
+  text += "    axle_axis: z\n";
+  text.insert(text.find("modules:"), "truth_time_offset_s: 847.85\nvehicle: {track_m: 1.46, wheelbase_m: 2.62, antenna_v_m: [0.4, 0.1, -1.5]}\n");
+  write_text(dir / "m.yaml", text);
+  const Manifest m = load_manifest(dir / "m.yaml", kQuiet);
+  EXPECT_EQ(m.modules[0].axle_axis, 2);
+  EXPECT_EQ(m.truth_time_offset, 847.85);
+  EXPECT_EQ(m.wheelbase, 2.62);
+  ASSERT_TRUE(m.antenna_inV.has_value());
+  EXPECT_EQ(*m.antenna_inV, Vec3(0.4, 0.1, -1.5));
+  save_manifest(m, dir / "m2.yaml");
+  const Manifest m2 = load_manifest(dir / "m2.yaml", kQuiet);
+  EXPECT_EQ(m2.modules[0].axle_axis, 2);
+  EXPECT_EQ(m2.truth_time_offset, 847.85);
+  EXPECT_EQ(m2.wheelbase, 2.62);
+  EXPECT_EQ(*m2.antenna_inV, *m.antenna_inV);
+  text = kMinimal;
+  text += "    axle_axis: w\n";
+  write_text(dir / "m.yaml", text);
+  EXPECT_HAS(load_error(dir, text), "axle_axis");
+}
+
 TEST(IoManifest, MinimalManifestUsesDefaultsAndConvertsUnits) {
   ScratchDir dir;
   write_text(dir / "m.yaml", kMinimal);
@@ -295,8 +336,8 @@ TEST(IoManifest, MissingRequiredKeys) {
              "m.yaml': modules[0]: missing required key 'file'");
   EXPECT_HAS(load_error(dir, "initial: {lat_deg: 1, lon_deg: 2, h_m: 3, heading_deg: 4}\nmodules: []\n"),
              "missing required key 'format'");
-  EXPECT_HAS(load_error(dir, "format: wheelins-manifest-1\ninitial: {lat_deg: 1, lon_deg: 2, h_m: 3}\n"),
-             "initial: missing required key 'heading_deg'");
+  EXPECT_HAS(load_error(dir, "format: wheelins-manifest-1\ninitial: {lat_deg: 1, lon_deg: 2}\n"),
+             "initial: missing required key 'h_m'");
   EXPECT_HAS(load_error(dir, "format: wheelins-manifest-2\n"), "unsupported manifest format 'wheelins-manifest-2'");
   EXPECT_HAS(load_error(dir, ""), "the manifest is empty");
 }

@@ -65,7 +65,7 @@ WheelImuCalibrator::WheelImuCalibrator(const ImuModule& module, double static_st
                                        double expected_end)
     : module_(module),
       opt_(opt),
-      C_StoB_(dcm_from_euler(module.mounting_rpy)),
+      C_StoB_(wheel_sensor_to_body(module)),
       static_{static_start, static_end} {
   reserve_bins(bins_, static_end, expected_end, opt_.rate_bin_s);
   reserve_bins(axle_bins_, static_end, expected_end, opt_.yaw_bin_s);
@@ -214,7 +214,7 @@ WheelImuCalibration WheelImuCalibrator::result() const {
   r.axle_tilt_y = with_prior(0.0, opt_.mounting_prior_std, dy, sy, opt_.observed_ratio);
   r.axle_tilt_z = with_prior(0.0, opt_.mounting_prior_std, dz, sz, opt_.observed_ratio);
   const Mat3 R = dcm_from_rotvec(Vec3(0.0, r.axle_tilt_y.value, r.axle_tilt_z.value));
-  r.mounting_rpy = euler_from_dcm(R * C_StoB_);
+  r.mounting_rpy = euler_from_dcm(R * C_StoB_ * axle_axis_permutation(module_.axle_axis).transpose());
 
   // Lever arm, in the corrected frame: the chunk-centred sums (the open chunk included)
   // rotated by R; the normal matrix of (l_y, l_z) is (Scc + Sss) I.

@@ -11,7 +11,7 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
                    const MechanizationOptions& mech)
     : Subsystem(module, mech),
       opt_(opt),
-      C_StoB_(dcm_from_euler(module.mounting_rpy)),
+      C_StoB_(wheel_sensor_to_body(module)),
       axle_sign_(module.axle_sign) {
   // Its b x-axis is the axle: the attitude update splits the spin off (nav/mechanization.hpp).
   mech_.spin_about_x = true;

@@ -104,15 +104,15 @@ std::string si_to_human(double si, Unit u) {
 }
 
 const std::vector<std::string> kTopKeys = {"format",         "name",         "truth",
-                                           "odometer",       "static_period_s", "initial",
-                                           "gravity_m_s2",   "earth_rotation", "vehicle",
-                                           "modules"};
+                                           "truth_time_offset_s", "odometer", "static_period_s",
+                                           "initial",        "gravity_m_s2", "earth_rotation",
+                                           "vehicle",        "modules"};
 const std::vector<std::string> kInitialKeys = {"lat_deg", "lon_deg", "h_m", "heading_deg"};
-const std::vector<std::string> kVehicleKeys = {"track_m"};
+const std::vector<std::string> kVehicleKeys = {"track_m", "wheelbase_m", "antenna_v_m"};
 const std::vector<std::string> kModuleKeys = {
     "name",          "kind",          "group",        "chip",      "file",
     "format",        "layout",        "rate_hz",      "time_offset_s", "position_v_m",
-    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "wheel_radius_m", "gyro_range_dps",
+    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "axle_axis",  "wheel_radius_m", "gyro_range_dps",
     "accel_range_m_s2", "noise"};
 
 /// One noise key: its name, its unit factor and the ImuNoise member it fills.
@@ -197,6 +197,10 @@ Manifest Loader::load() {
 
   if (auto v = get(root, "name"); v.IsDefined()) m.name = text(v, "name");
   if (auto v = get(root, "truth"); v.IsDefined()) m.truth_file = fs::path(text(v, "truth"));
+  if (auto v = get(root, "truth_time_offset_s"); v.IsDefined()) {
+    m.truth_time_offset = number(v, "truth_time_offset_s");
+    range(m.truth_time_offset, -1e7, 1e7, "truth_time_offset_s", v, "s");
+  }
   if (auto v = get(root, "odometer"); v.IsDefined()) m.odometer_file = fs::path(text(v, "odometer"));
 
   if (auto v = get(root, "static_period_s"); v.IsDefined()) {
@@ -224,7 +228,7 @@ Manifest Loader::load() {
     const YAML::Node lat = required(init, "initial", "lat_deg");
     const YAML::Node lon = required(init, "initial", "lon_deg");
     const YAML::Node h = required(init, "initial", "h_m");
-    const YAML::Node hd = required(init, "initial", "heading_deg");
+    const YAML::Node hd = get(init, "heading_deg");
     const double lat_deg = number(lat, "initial.lat_deg");
     const double lon_deg = number(lon, "initial.lon_deg");
     if (std::abs(lat_deg) > 90.0)
@@ -234,9 +238,12 @@ Manifest Loader::load() {
     m.origin.lat = number(lat, "initial.lat_deg", kDegU);
     m.origin.lon = number(lon, "initial.lon_deg", kDegU);
     range(number(h, "initial.h_m"), -1000.0, 10000.0, "initial.h_m", h, "m (ellipsoidal)");
-    range(number(hd, "initial.heading_deg"), -360.0, 360.0, "initial.heading_deg", hd, "deg");
     m.origin.h = number(h, "initial.h_m");
-    m.initial_heading = number(hd, "initial.heading_deg", kDegU);
+    m.heading_known = hd.IsDefined();
+    if (m.heading_known) {
+      range(number(hd, "initial.heading_deg"), -360.0, 360.0, "initial.heading_deg", hd, "deg");
+      m.initial_heading = number(hd, "initial.heading_deg", kDegU);
+    }
   }
 
   if (auto v = get(root, "gravity_m_s2"); v.IsDefined()) {
@@ -251,6 +258,16 @@ Manifest Loader::load() {
     if (auto v = get(veh, "track_m"); v.IsDefined()) {
       m.track_width = number(v, "vehicle.track_m");
       range(m.track_width, 0.0, 10.0, "vehicle.track_m", v, "m (0: unknown)");
+    }
+    if (auto v = get(veh, "wheelbase_m"); v.IsDefined()) {
+      m.wheelbase = number(v, "vehicle.wheelbase_m");
+      range(m.wheelbase, 0.0, 20.0, "vehicle.wheelbase_m", v, "m (0: unknown)");
+    }
+    if (auto v = get(veh, "antenna_v_m"); v.IsDefined()) {
+      const Vec3 a = vec3(v, "vehicle.antenna_v_m");
+      for (std::size_t i = 0; i < 3; ++i)
+        range(a[static_cast<int>(i)], -20.0, 20.0, index_path("vehicle.antenna_v_m", i), v, "m");
+      m.antenna_inV = a;
     }
   }
 
@@ -321,9 +338,11 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
     const double a = number(v, join(path, "axle_sign"));
     if (a != 1.0 && a != -1.0)
       fail(join(path, "axle_sign"),
-           "must be +1 (b x-axis points right) or -1 (points left), got " + describe(v), &v);
+           "must be +1 (the axle axis points to the vehicle's right) or -1 (to its left), got " + describe(v), &v);
     s.axle_sign = static_cast<int>(a);
   }
+  if (auto v = get(n, "axle_axis"); v.IsDefined())
+    s.axle_axis = choice<int>(v, join(path, "axle_axis"), {{"x", 0}, {"y", 1}, {"z", 2}});
   if (auto v = get(n, "wheel_radius_m"); v.IsDefined()) {
     s.wheel_radius = number(v, join(path, "wheel_radius_m"));
     if (s.kind == ModuleKind::kWheel)
@@ -440,6 +459,7 @@ VehicleSetup vehicle_setup(const Manifest& m) {
   s.static_start = m.static_start;
   s.static_end = m.static_end;
   s.initial_heading = m.initial_heading;
+  s.heading_known = m.heading_known;
   s.gravity = m.gravity_or_default();
   for (const ModuleSpec& spec : m.modules) {
     s.modules.push_back(spec);  // the ImuModule part
@@ -463,6 +483,9 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
   w.line(0, std::string("format: ") + kFormatId, "format");
   if (!m.name.empty()) w.line(0, "name: " + yaml_string(m.name), "name");
   if (m.truth_file) w.line(0, "truth: " + yaml_string(rebase(m, *m.truth_file, dir).string()), "truth");
+  if (m.truth_time_offset != 0.0)
+    w.line(0, "truth_time_offset_s: " + num(m.truth_time_offset), "truth_time_offset_s",
+           "added to the truth's times");
   if (m.odometer_file)
     w.line(0, "odometer: " + yaml_string(rebase(m, *m.odometer_file, dir).string()), "odometer");
   w.line(0, "static_period_s: [" + num(m.static_start) + ", " + num(m.static_end) + "]",
@@ -471,12 +494,16 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
   w.line(2, "lat_deg: " + num(m.origin.lat, kDegU), "initial.lat_deg");
   w.line(2, "lon_deg: " + num(m.origin.lon, kDegU), "initial.lon_deg");
   w.line(2, "h_m: " + num(m.origin.h), "initial.h_m", "ellipsoidal height");
-  w.line(2, "heading_deg: " + num(m.initial_heading, kDegU), "initial.heading_deg");
+  if (m.heading_known) w.line(2, "heading_deg: " + num(m.initial_heading, kDegU), "initial.heading_deg");
   if (m.gravity) w.line(0, "gravity_m_s2: " + num(*m.gravity), "gravity_m_s2");
   w.line(0, std::string("earth_rotation: ") + (m.earth_rotation ? "true" : "false"), "earth_rotation",
          "the data contain the earth rotation rate");
   w.line(0, "vehicle:", "vehicle");
   w.line(2, "track_m: " + num(m.track_width), "vehicle.track_m", "0: unknown");
+  if (m.wheelbase != 0.0) w.line(2, "wheelbase_m: " + num(m.wheelbase), "vehicle.wheelbase_m");
+  if (m.antenna_inV)
+    w.line(2, "antenna_v_m: " + vec(*m.antenna_inV), "vehicle.antenna_v_m",
+           "the truth's antenna in the v-frame");
   w.line(0, "modules:", "modules");
   for (std::size_t i = 0; i < m.modules.size(); ++i) {
     const ModuleSpec& s = m.modules[i];
@@ -499,9 +526,12 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
              "IMU centre -> wheel centre, b-frame");
     w.line(4, "mounting_deg: " + vec(s.mounting_rpy, kDegU), p + "mounting_deg",
            wheel ? "[roll, pitch, yaw] sensor axes vs ideal wheel frame" : "[roll, pitch, yaw] C_b^v");
+    if (s.axle_axis != 0)
+      w.line(4, std::string("axle_axis: ") + "xyz"[s.axle_axis], p + "axle_axis",
+             "the sensor axis along the axle");
     if (wheel || s.axle_sign != 1)
       w.line(4, "axle_sign: " + std::to_string(s.axle_sign), p + "axle_sign",
-             "+1: b x-axis points right, -1: left");
+             "+1: the axle axis points right, -1: left");
     if (wheel || s.wheel_radius != 0.0)
       w.line(4, "wheel_radius_m: " + num(s.wheel_radius), p + "wheel_radius_m");
     if (s.gyro_range > 0.0)

@@ -59,9 +59,17 @@ struct Manifest {
   double static_end = 0.0;
   earth::Geodetic origin;           ///< the w-frame origin (reference point o at the start)
   double initial_heading = 0.0;     ///< vehicle heading at the start [rad]
+  /// False when `initial.heading_deg` is absent: the run starts in a local (odometry)
+  /// frame with heading 0 and says so.
+  bool heading_known = true;
+  double truth_time_offset = 0.0;   ///< added to the truth file's times [s]
   std::optional<double> gravity;    ///< [m/s^2]; default: normal gravity at the origin
   bool earth_rotation = true;       ///< the data contain the earth rotation rate
   double track_width = 0.0;         ///< [m], informational
+  double wheelbase = 0.0;           ///< [m], rear to front axle; 0 = unknown
+  /// The reference's antenna (the point the truth positions are of) in the v-frame [m];
+  /// none: the truth is of the reference point o itself.
+  std::optional<Vec3> antenna_inV;
   std::vector<ModuleSpec> modules;
 
   /// Absolute path of a file named in the manifest.

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/math/rotation.hpp"
 #include "wheelins/nav/earth.hpp"
 
 namespace wheelins {
@@ -45,6 +46,10 @@ struct ImuModule {
   /// sensor axes from the ideal wheel b-frame (the paper's mounting angles). [rad]
   Vec3 mounting_rpy = Vec3::Zero();
   int axle_sign = 1;            ///< Wheel-IMU: +1 if b x-axis points right, -1 if left
+  /// Wheel-IMU: which sensor axis lies along the axle (0: x, 1: y, 2: z). The b-frame takes
+  /// it as its x-axis and the next two cyclically (y, z for x; z, x for y; x, y for z), so
+  /// the b-frame stays right-handed; mounting_rpy then rotates the result (sensor_to_body()).
+  int axle_axis = 0;
   double wheel_radius = 0.0;    ///< Wheel-IMU nominal wheel radius [m]
   /// Gyro full scale [rad/s] (readings at it are saturated); 0 = not stated.
   double gyro_range = 0.0;
@@ -54,6 +59,15 @@ struct ImuModule {
   ImuNoise noise;
 };
 
+/// The cyclic permutation that takes sensor axis `axle_axis` to the b-frame's x-axis
+/// (the next sensor axes to y and z): b = P * sensor.
+Mat3 axle_axis_permutation(int axle_axis);
+
+/// C_s^b of a module: the sensor axes into its b-frame. A Wheel-IMU's axes are first
+/// permuted so that its axle axis is x (axle_axis_permutation), then rotated by its mounting
+/// angles; a Body-IMU's mounting is C_b^v and its samples stay in sensor axes (identity).
+Mat3 wheel_sensor_to_body(const ImuModule& module);
+
 /// What a navigation run is told before its first sample.
 struct VehicleSetup {
   std::string source;             ///< where it was stated (e.g. a manifest file), for messages
@@ -61,6 +75,9 @@ struct VehicleSetup {
   double static_start = 0.0;      ///< static period for the initial alignment [s]
   double static_end = 0.0;
   double initial_heading = 0.0;   ///< vehicle heading at the start [rad]
+  /// False when nothing stated the initial heading: the run navigates in a local frame
+  /// (an odometry frame, as ROS's `odom`) whose x-axis is the vehicle's heading at the start.
+  bool heading_known = true;
   double gravity = 9.8;           ///< [m/s^2]
   std::vector<ImuModule> modules;
   /// Per module (same order): where its samples come from (e.g. a file), for messages.
