@@ -1,0 +1,201 @@
+// The manifest drafted from a survey (draft.hpp).
+#include "wheelins/survey/draft.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "wheelins/nav/types.hpp"
+
+namespace wheelins::survey {
+namespace {
+
+constexpr const char* kTodo = "TODO: measure";
+
+std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
+/// The vehicle keys of a calibrated manifest's module, onto a drafted one.
+void carry_over(const ModuleSpec& from, ModuleSpec& to) {
+  to.kind = from.kind;
+  to.p_inV = from.p_inV;
+  to.lever_arm_inB = from.lever_arm_inB;
+  to.mounting_rpy = from.mounting_rpy;
+  to.axle_axis = from.axle_axis;
+  to.axle_sign = from.axle_sign;
+  to.wheel_radius = from.wheel_radius;
+  if (from.gyro_range > 0.0) to.gyro_range = from.gyro_range;
+  if (from.accel_range > 0.0) to.accel_range = from.accel_range;
+  to.noise = from.noise;
+  to.noise_stated = from.noise_stated;
+}
+
+}  // namespace
+
+VehicleType vehicle_type(const std::string& name) {
+  if (name == "car") return {"car", 0.30, 1.50, 2.60, Vec3(1.3, 0.0, -0.6)};
+  if (name == "robot") return {"robot", 0.097, 0.33, 0.38, Vec3(0.1, 0.0, -0.25)};
+  throw InputError("unknown vehicle type '" + name + "' (known: car, robot)");
+}
+
+ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<DraftModule>& modules,
+                                const DraftOptions& o) {
+  ManifestDraft d;
+  d.layout = "survey";
+  Manifest& m = d.manifest;
+  auto& note = d.notes.comments;
+  m.name = o.name;
+  const VehicleType& vt = o.vehicle;
+  const Manifest* veh = o.vehicle_from ? &*o.vehicle_from : nullptr;
+  const std::string typical = " (typical " + vt.name + (o.vehicle_type_given ? "" : "; --vehicle-type to change") + ")";
+  bool radius_todo = false, lever_todo = false, body_pos_todo = false, side_todo = false;
+  for (std::size_t i = 0; i < modules.size(); ++i) {
+    const DraftModule& in = modules[i];
+    const ModuleFinding* f = survey.find(in.name);
+    if (!f) throw InputError("module '" + in.name + "' was not surveyed");
+    const std::string key = "modules[" + std::to_string(i) + "].";
+    ModuleSpec s;
+    s.name = in.name;
+    s.group = in.name;
+    s.kind = f->kind;
+    s.file = in.file;
+    s.layout = in.layout;
+    s.format = SampleFormat::kRate;
+    s.rate_hz = in.rate_hz;
+    s.gyro_range = in.gyro_range;
+    s.accel_range = in.accel_range;
+    s.noise_stated = 0;
+    s.time_offset = in.input_offset + (f->clock.found ? f->clock.offset : 0.0);
+    if (f->clock_reference)
+      note[key + "time_offset_s"] = "the reference clock";
+    else if (f->clock.found)
+      note[key + "time_offset_s"] = fmt("from the data: +- %.3f s (correlation %.3f, ", f->clock.sigma, f->clock.correlation) +
+                                    f->clock_basis + ")";
+    else {
+      note[key + "time_offset_s"] = "TODO: not found from the data (no overlap with the other modules)";
+      d.todo.push_back(in.name + ": time_offset_s (its data did not overlap the others')");
+    }
+    note[key + "kind"] = f->kind == ModuleKind::kWheel
+                             ? fmt("from the data: spins about one axis (95th percentile %.1f rad/s)", f->traits.spin_p95)
+                             : fmt("from the data: does not spin (95th percentile %.2f rad/s)", f->traits.spin_p95);
+    const ModuleSpec* prior = veh ? veh->find(in.name) : nullptr;
+    if (prior && prior->kind != f->kind)
+      throw InputError("module '" + in.name + "': the vehicle manifest '" + veh->path.string() + "' calls it a " +
+                       to_string(prior->kind) + " IMU, but its data " +
+                       (f->kind == ModuleKind::kWheel ? "spin like a wheel's" : "do not spin"));
+    if (f->kind == ModuleKind::kWheel) {
+      s.axle_axis = f->axle_axis;
+      s.axle_sign = f->axle_sign;
+      s.wheel_radius = vt.wheel_radius;
+      s.p_inV = Vec3(f->steered ? vt.wheelbase : 0.0, f->side * 0.5 * vt.track, 0.0);
+      note[key + "axle_axis"] = "from the data: the spin axis";
+      note[key + "axle_sign"] = f->forward_clear
+                                    ? fmt("from the data: %.0f %% of its turning one way (a vehicle mostly drives forward)",
+                                          50.0 * (1.0 + std::abs(f->traits.spin_direction)))
+                                    : "TODO: the data turn both ways; check which way is forward";
+      if (!f->forward_clear) d.todo.push_back(in.name + ": axle_sign (its data turn both ways)");
+      if (prior) {
+        carry_over(*prior, s);
+        note[key + "wheel_radius_m"] = "from the vehicle manifest";
+        note[key + "position_v_m"] = "from the vehicle manifest";
+        note[key + "lever_arm_b_m"] = "from the vehicle manifest";
+        if (prior->axle_axis != f->axle_axis || prior->axle_sign != f->axle_sign)
+          d.facts.push_back(in.name + ": the vehicle manifest's axle (axis, sign) differs from this recording's data; the data's kept");
+        s.axle_axis = f->axle_axis;
+        s.axle_sign = f->axle_sign;
+      } else {
+        radius_todo = lever_todo = true;
+        note[key + "wheel_radius_m"] = "TODO: typical " + vt.name + " value; calibrate against a reference (wheelins calibrate --reference) or measure";
+        note[key + "lever_arm_b_m"] = "estimated from the data by every run (calibration.yaml)";
+        std::string where = f->steered ? "front (steered)" : "rear axle";
+        if (f->side) where += std::string(", ") + (f->side > 0 ? "right" : "left");
+        else side_todo = true;
+        note[key + "position_v_m"] = "from the data: " + where + "; x, y TODO" + typical;
+        note[key + "mounting_deg"] = "estimated from the data by every run (calibration.yaml)";
+      }
+      if (f->steered)
+        d.facts.push_back(in.name + fmt(": a steered wheel (its yaw rate leads the vehicle's by %.2f s): "
+                                        "navigate with the unsteered wheels", f->yaw_lead));
+    } else {
+      s.lever_arm_inB = Vec3::Zero();
+      s.p_inV = vt.body_position;
+      // C_b^v from the measured axes: rows forward, right, down in sensor axes.
+      Mat3 C;
+      const Vec3 down = -f->traits.up;
+      const Vec3 fwd = f->axes_found ? f->forward : Vec3::UnitX();
+      const Vec3 fw = (fwd - fwd.dot(down) * down).normalized();
+      const Vec3 right = down.cross(fw);
+      C.row(0) = fw.transpose();
+      C.row(1) = right.transpose();
+      C.row(2) = down.transpose();
+      s.mounting_rpy = euler_from_dcm(C);
+      note[key + "mounting_deg"] = f->axes_found
+                                       ? fmt("from the data: up-axis at rest, forward axis from accelerations (fit %.2f); refined by every run", f->forward_fit)
+                                       : "roll, pitch from the data; yaw TODO (no clear forward acceleration)";
+      if (!f->axes_found) d.todo.push_back(in.name + ": mounting_deg yaw (the data showed no clear forward axis)");
+      if (prior) {
+        carry_over(*prior, s);
+        note[key + "mounting_deg"] = "from the vehicle manifest";
+        note[key + "position_v_m"] = "from the vehicle manifest";
+      } else {
+        body_pos_todo = true;
+        note[key + "position_v_m"] = "TODO: measure; refined by every run relative to the wheels" + typical;
+      }
+    }
+    m.modules.push_back(std::move(s));
+  }
+
+  // The static period and the start.
+  if (survey.static_period) {
+    m.static_start = survey.static_period->start;
+    m.static_end = survey.static_period->end;
+    note["static_period_s"] = "from the data: every wheel at rest, on the reference clock";
+  } else {
+    d.todo.push_back("static_period_s: the modules never rest together at the start (a static period is needed to align)");
+    note["static_period_s"] = "TODO: no common rest found";
+  }
+  m.earth_rotation = true;
+  m.track_width = veh ? veh->track_width : vt.track;
+  m.wheelbase = veh ? veh->wheelbase : vt.wheelbase;
+  if (veh && veh->antenna_inV) m.antenna_inV = veh->antenna_inV;
+  note["vehicle.track_m"] = veh ? "from the vehicle manifest" : "TODO: measure" + typical;
+  note["vehicle.wheelbase_m"] = veh ? "from the vehicle manifest" : "TODO: measure" + typical;
+  m.heading_known = false;
+  if (o.origin) {
+    m.origin = *o.origin;
+    note["initial.lat_deg"] = "the reference at the start (its antenna)";
+  } else {
+    m.origin = earth::Geodetic{0.0, 0.0, 0.0};
+    note["initial.lat_deg"] = "TODO: the start position (gravity and the earth rate depend on it)";
+    d.todo.push_back("initial: the start position (lat_deg, lon_deg, h_m; no reference given)");
+  }
+  if (o.truth_file) {
+    m.truth_file = *o.truth_file;
+    if (o.truth_clock && o.truth_clock->found) {
+      m.truth_time_offset = o.truth_clock->offset;
+      note["truth_time_offset_s"] = fmt("from the data: +- %.3f s (its speed against the wheels', correlation %.4f)",
+                                        o.truth_clock->sigma, o.truth_clock->correlation);
+    } else {
+      d.todo.push_back("truth_time_offset_s: the reference's clock could not be fitted to the IMUs'");
+    }
+  }
+  // What is still to do.
+  if (radius_todo)
+    d.todo.insert(d.todo.begin(), "wheel_radius_m of every wheel: typical " + vt.name +
+                                      " values written; `wheelins calibrate --reference` fits them to a GNSS track");
+  if (lever_todo) d.todo.push_back("wheel position_v_m (x, y) and vehicle.track_m, vehicle.wheelbase_m: typical values written");
+  if (body_pos_todo) d.todo.push_back("body position_v_m: a typical value written (a run refines it relative to the wheels)");
+  if (side_todo) d.todo.push_back("which side each wheel is on (y of position_v_m): not told by the data (one wheel, or no turns)");
+  d.facts.insert(d.facts.end(), survey.notes.begin(), survey.notes.end());
+  if (o.truth_clock)
+    for (const auto& n : o.truth_clock->notes) d.facts.push_back("reference clock: " + n);
+  d.notes.header = {"drafted by `wheelins import` from " + o.source,
+                    "what the data tell is filled in (see the comments); values marked 'TODO' are guesses",
+                    "no initial heading: a run navigates in a local frame (heading 0 at the start) unless one is set",
+                    "no noise figures: they are identified from the data (noise.yaml of a run)"};
+  return d;
+}
+
+}  // namespace wheelins::survey
