@@ -42,6 +42,7 @@ struct RunArgs {
   bool no_faults = false;
   bool fixed_noise = false;
   bool no_evaluate = false;
+  bool no_data_checks = false;
   bool force = false;
   bool quiet = false;
   std::optional<double> duration, output_interval, covariance_interval;
@@ -101,6 +102,7 @@ int run(const RunArgs& a) {
   if (a.force) cfg.overwrite = true;
   if (a.duration) cfg.max_duration = *a.duration;
   if (a.no_faults) cfg.nav.faults.enabled = false;
+  if (a.no_data_checks) cfg.data_checks = false;
   if (a.fixed_noise) cfg.nav.noise.enabled = false;
   if (a.output_interval) cfg.nav.output_interval = *a.output_interval;
   if (a.covariance_interval) cfg.nav.covariance_interval = *a.covariance_interval;
@@ -123,6 +125,9 @@ int run(const RunArgs& a) {
   for (std::size_t i = 0; i < req.modules.size(); ++i) std::cout << (i ? ", " : "") << req.modules[i];
   std::cout << "] on '" << req.manifest.path.string() << "'\n";
   if (!a.quiet) std::cout << req.nav.describe();
+  if (!req.manifest.heading_known)
+    std::cout << "initial heading:            not in the manifest: a local frame (odometry frame, as ROS's odom) "
+                 "with the vehicle's heading 0 at the start\n";
 
   const RunResult res = run_navigation(req);
   const NavigatorStats& st = res.stats;
@@ -219,6 +224,9 @@ const bool registered = cli::register_command(
       sub.add_flag("--no-evaluate", a->no_evaluate,
                    "Do not evaluate against the manifest's truth (the evaluation streams the truth "
                    "file alongside the run)");
+      sub.add_flag("--no-data-checks", a->no_data_checks,
+                   "Run the manifest as it is, without holding it against its data first (the axle "
+                   "axis and sign, clock offsets, kinds, sides, a body's mounting)");
       sub.add_flag("--fixed-noise", a->fixed_noise,
                    "Hold the manifest's noise figures (or the defaults) fixed instead of identifying "
                    "them from the data (docs/filter.md section 13)");

@@ -19,6 +19,7 @@
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/util/interrupt.hpp"
 #include "wheelins/util/progress.hpp"
+#include "wheelins/survey/checks.hpp"
 
 namespace wheelins {
 namespace fs = std::filesystem;
@@ -99,6 +100,25 @@ void validate_run_request(const RunRequest& r) {
     }
 }
 
+std::vector<std::string> check_manifest_against_data(const Manifest& m, const std::vector<std::string>& modules,
+                                                     const WarningSink& warn) {
+  survey::SurveyOptions so;
+  so.series.max_span = 300.0;  // the checks need minutes of driving, not hours
+  const survey::DatasetSurvey s = survey::survey_modules(survey::survey_inputs(m, modules), so);
+  std::string errors;
+  for (const auto& c : survey::check_against_data(m, modules, s)) {
+    if (c.level == survey::DataCheck::Level::kError)
+      errors += "\n  " + c.message;
+    else if (warn)
+      warn(quote(m.path) + ": " + c.message);
+  }
+  if (!errors.empty())
+    throw InputError(quote(m.path) + ": the manifest disagrees with its data:" + errors +
+                     "\n(what the data show is checked before a run; --no-data-checks, or data_checks: false in a "
+                     "run configuration, runs the manifest as it is)");
+  return s.notes;
+}
+
 std::vector<fs::path> run_output_files(const RunRequest& r) {
   std::vector<fs::path> files;
   if (r.output_dir.empty()) return files;
@@ -129,6 +149,7 @@ RunResult run_navigation(const RunRequest& r) {
     out_dir = std::make_unique<OutputDir>(r.output_dir, o);
   }
   auto staged = [&](const fs::path& final_file) { return out_dir->staging() / final_file.filename(); };
+  if (r.data_checks) check_manifest_against_data(r.manifest, r.modules, r.warn);
 
   // The installation calibration pass: the Wheel-IMUs' files read once before navigating.
   InstallationCalibration calibration;

@@ -30,6 +30,10 @@ struct RunRequest {
   /// their files (calibration.yaml beside the trajectory), or the manifest's.
   CalibrationMode calibration = CalibrationMode::kEstimate;
   InstallationCalibrationOptions calibration_options;
+  /// What the data can check of the manifest is checked before the run (survey/checks.hpp):
+  /// a disagreement is an InputError naming the module and the setting; false runs the
+  /// manifest as it is.
+  bool data_checks = true;
   WarningSink warn;
   /// Called for every vehicle record (e.g. to evaluate in memory); may be empty.
   std::function<void(const TrajectoryRecord&)> on_record;
@@ -58,6 +62,11 @@ RunResult run_navigation(const RunRequest& request);
 /// known and listed once, formats listed once, the numbers in their ranges, the
 /// centralized filter on several modules, every module's rate above the gap threshold.
 void validate_run_request(const RunRequest& request);
+
+/// The manifest's selected modules held against their data (survey/checks.hpp): throws
+/// InputError listing every disagreement; warnings go to `warn`. Returns the survey's notes.
+std::vector<std::string> check_manifest_against_data(const Manifest& manifest, const std::vector<std::string>& modules,
+                                                     const WarningSink& warn);
 
 /// The files a run would write (to refuse early, before any work, if they exist).
 std::vector<std::filesystem::path> run_output_files(const RunRequest& request);

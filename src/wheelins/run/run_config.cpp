@@ -56,7 +56,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   const YamlReader y(file, warn, "run configuration");
   const YAML::Node& root = y.root();
   y.check_keys(root, "", {"dataset", "configuration", "chips", "modules", "output", "duration_s",
-                          "calibration", "filter", "fusion", "faults", "noise"});
+                          "calibration", "data_checks", "filter", "fusion", "faults", "noise"});
   RunConfig c;
   const fs::path base = file.parent_path();
   auto rel = [&](const std::string& p) { return fs::path(p).is_absolute() ? fs::path(p) : base / p; };
@@ -74,6 +74,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     if (c.max_duration <= 0) y.fail("duration_s", "must be > 0 s (leave it out for all the data)", &v);
   }
 
+  if (auto v = y.get(root, "data_checks"); v.IsDefined()) c.data_checks = y.boolean(v, "data_checks");
   if (auto v = y.get(root, "calibration"); v.IsDefined())
     c.calibration = y.choice<CalibrationMode>(
         v, "calibration", {{"estimate", CalibrationMode::kEstimate}, {"manifest", CalibrationMode::kManifest}});
@@ -317,6 +318,7 @@ RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn) {
   r.write_subsystems = cfg.write_subsystems;
   r.max_duration = cfg.max_duration;
   r.calibration = cfg.calibration;
+  r.data_checks = cfg.data_checks;
   r.warn = warn;
   return r;
 }

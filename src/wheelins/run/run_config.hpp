@@ -25,6 +25,8 @@ struct RunConfig {
   std::string earth_rotation = "auto";     ///< auto (from the manifest) | true | false
   /// The Wheel-IMUs' installation: estimated from the data (default) or the manifest's.
   CalibrationMode calibration = CalibrationMode::kEstimate;
+  /// The manifest held against its data before the run (survey/checks.hpp).
+  bool data_checks = true;
   NavigatorOptions nav;
 };
 
