@@ -14,6 +14,7 @@
 #include "cli.hpp"
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/run/calibration.hpp"
+#include "wheelins/run/reference_calibration.hpp"
 
 namespace {
 using namespace wheelins;
@@ -26,6 +27,8 @@ struct Options {
   std::string report;
   std::optional<double> duration;
   bool no_faults = false;
+  bool reference = false;
+  std::optional<double> align_length;
   bool force = false;
   bool quiet = false;
 };
@@ -74,6 +77,14 @@ int run(const Options& o) {
   const auto cal = calibrate_installation(m, modules, InstallationCalibrationOptions{}, !o.no_faults,
                                           !o.quiet, t_end);
   std::cout << calibration_report(cal);
+  std::optional<ReferenceCalibration> ref;
+  if (o.reference) {
+    ReferenceCalibrationOptions ro;
+    ro.progress = !o.quiet;
+    if (o.align_length) ro.align_length = *o.align_length;
+    ref = calibrate_against_reference(m, modules, cal, ro, stderr_sink());
+    std::cout << reference_calibration_report(*ref);
+  }
   std::size_t unobserved = 0;
   for (const auto& c : cal.wheels)
     if (!c.axle_tilt_y.observed || !c.axle_tilt_z.observed || !c.lever_arm[1].observed ||
@@ -87,8 +98,10 @@ int run(const Options& o) {
   for (const fs::path& f : {out, report})
     if (f.has_parent_path()) fs::create_directories(f.parent_path());
   AtomicTextFile refined(out, o.force), estimates(report, o.force);
-  refined.write(manifest_to_yaml(apply_calibration(m, cal), out.has_parent_path() ? out.parent_path() : fs::path(".")));
-  estimates.write(calibration_yaml(cal, m));
+  Manifest refined_manifest = apply_calibration(m, cal);
+  if (ref) refined_manifest = apply_reference_calibration(refined_manifest, *ref);
+  refined.write(manifest_to_yaml(refined_manifest, out.has_parent_path() ? out.parent_path() : fs::path(".")));
+  estimates.write(calibration_yaml(cal, m) + (ref ? reference_calibration_yaml(*ref, m) : std::string()));
   refined.commit();
   estimates.commit();
   std::cout << "wrote " << out.string() << "\nwrote " << report.string() << "\n";
@@ -111,6 +124,11 @@ const bool registered = cli::register_command(
       sub.add_option("--modules", o->modules, "modules to calibrate (default: all)");
       sub.add_option("--duration", o->duration, "seconds of the recording after the static period to use");
       sub.add_flag("--no-faults", o->no_faults, "no fault isolation of the input samples");
+      sub.add_flag("--reference", o->reference,
+                   "also estimate what only the manifest's truth (a GNSS track) shows: each wheel's "
+                   "absolute rolling radius, the initial heading and the antenna's position");
+      sub.add_option("--align-length", o->align_length,
+                     "metres of the reference's travel the initial heading is fitted on (default 300; 0: all)");
       sub.add_flag("--force,-f", o->force, "overwrite existing output files");
       sub.add_flag("--quiet,-q", o->quiet, "no progress line");
       return [o]() { return run(*o); };

@@ -1,0 +1,299 @@
+// Calibration against a reference track (reference_calibration.hpp).
+#include "wheelins/run/reference_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "wheelins/io/text_util.hpp"
+#include "wheelins/io/truth.hpp"
+#include "wheelins/run/run.hpp"
+#include "wheelins/survey/dataset.hpp"
+
+namespace wheelins {
+namespace {
+
+using io_detail::quote;
+
+std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
+  char buf[240];
+  std::snprintf(buf, sizeof buf, f, a, b, c, d);
+  return buf;
+}
+
+/// A series' per-bin signal at time t (linear; clamped).
+struct Sampled {
+  const survey::Series* s;
+  std::vector<double> x;
+  double at(double t) const { return survey::sample_at(*s, x, t); }
+};
+
+struct Fit2 {
+  double a = 0.0, b = 0.0;       ///< v = a * x + b * y
+  double sigma_a = 0.0, corr = 0.0;
+  std::size_t n = 0;
+};
+
+/// Least squares v = a x + b y over the rows kept; sigma of a from the residuals.
+Fit2 ls2(const std::vector<double>& v, const std::vector<double>& x, const std::vector<double>& y,
+         const std::vector<std::uint8_t>& keep) {
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  double sv = 0.0, svv = 0.0;
+  Fit2 f;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (!keep[k]) continue;
+    const Eigen::Vector2d r(x[k], y[k]);
+    A += r * r.transpose();
+    b += r * v[k];
+    sv += v[k];
+    svv += v[k] * v[k];
+    ++f.n;
+  }
+  if (f.n < 10 || std::abs(A.determinant()) < 1e-12) return f;
+  const Eigen::Vector2d c = A.ldlt().solve(b);
+  f.a = c(0), f.b = c(1);
+  double ss = 0.0;
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (keep[k]) ss += std::pow(v[k] - f.a * x[k] - f.b * y[k], 2);
+  const double n = static_cast<double>(f.n);
+  f.sigma_a = std::sqrt(ss / std::max(1.0, n - 2.0) * A.inverse()(0, 0));
+  const double var = svv - sv * sv / n;
+  f.corr = var > 0.0 ? std::sqrt(std::max(0.0, 1.0 - ss / var)) : 0.0;
+  return f;
+}
+
+}  // namespace
+
+ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::vector<std::string>& modules,
+                                                 const InstallationCalibration& installation,
+                                                 const ReferenceCalibrationOptions& o, const WarningSink& warn) {
+  ReferenceCalibration out;
+  const Manifest m = installation.empty() ? m0 : apply_calibration(m0, installation);
+  if (!m.truth_file)
+    throw InputError(quote(m.path) + ": names no truth: calibrating against a reference needs one (truth: FILE)");
+  const TruthData truth = read_truth(m.resolve(*m.truth_file));
+  const earth::LocalFrame frame(m.origin);
+  eval::PlanarTrack ref;
+  for (const TruthRecord& r : truth.records) {
+    ref.t.push_back(r.t + m.truth_time_offset);
+    ref.p_ne.push_back(frame.ned_from_geodetic(r.lla).head<2>());
+  }
+  if (ref.t.size() < 10) throw InputError(quote(truth.file) + ": fewer than 10 records: too short a reference");
+
+  // The modules' series (manifest clocks) and what the data say of them.
+  std::vector<survey::Series> S;
+  for (const auto& name : modules) {
+    const ModuleSpec* spec = m.find(name);
+    if (!spec) throw InputError(quote(m.path) + ": no module named '" + name + "'");
+    S.push_back(survey::read_series(name, m.resolve(spec->file), imu_read_options(*spec)));
+  }
+  const survey::DatasetSurvey sv = survey::survey_series(S);
+
+  // The vehicle's yaw rate (up positive): a Body-IMU's, else the unsteered wheels' mean.
+  std::vector<Sampled> yaw_sources;
+  for (std::size_t i = 0; i < modules.size(); ++i) {
+    const ModuleSpec& spec = *m.find(modules[i]);
+    const survey::ModuleFinding& f = sv.modules[i];
+    if (spec.kind != ModuleKind::kBody) continue;
+    const Mat3 C = dcm_from_euler(spec.mounting_rpy);
+    Sampled y{&S[i], std::vector<double>(S[i].size())};
+    for (std::size_t k = 0; k < S[i].size(); ++k) y.x[k] = -(C * (S[i].gyro[k] - f.traits.gyro_bias)).z();
+    yaw_sources.push_back(std::move(y));
+    break;
+  }
+  if (yaw_sources.empty())
+    for (std::size_t i = 0; i < modules.size(); ++i)
+      if (sv.modules[i].kind == ModuleKind::kWheel && !sv.modules[i].steered)
+        yaw_sources.push_back({&S[i], survey::yaw_rate(S[i], sv.modules[i].traits)});
+
+  // The reference's speed at its records (central differences).
+  std::vector<double> ref_v(ref.t.size(), 0.0);
+  for (std::size_t k = 1; k + 1 < ref.t.size(); ++k) {
+    const double dt = ref.t[k + 1] - ref.t[k - 1];
+    if (dt > 0.0) ref_v[k] = (ref.p_ne[k + 1] - ref.p_ne[k - 1]).norm() / dt;
+  }
+  auto ref_speed = [&](double t) {
+    const auto it = std::lower_bound(ref.t.begin(), ref.t.end(), t);
+    if (it == ref.t.begin() || it == ref.t.end()) return std::nan("");
+    const std::size_t k = static_cast<std::size_t>(it - ref.t.begin());
+    const double a = (t - ref.t[k - 1]) / (ref.t[k] - ref.t[k - 1]);
+    return (1.0 - a) * ref_v[k - 1] + a * ref_v[k];
+  };
+
+  // Each wheel's radius.
+  const double step = 0.05;
+  const int smooth = static_cast<int>(std::lround(1.0 / step));
+  for (std::size_t i = 0; i < modules.size(); ++i) {
+    const ModuleSpec& spec = *m.find(modules[i]);
+    if (spec.kind != ModuleKind::kWheel) continue;
+    WheelRadiusFit w;
+    w.module = spec.name;
+    w.manifest_radius = spec.wheel_radius;
+    w.radius = CalibratedValue{spec.wheel_radius, 0.0, false};
+    const Mat3 C = wheel_sensor_to_body(spec);
+    Sampled omega{&S[i], std::vector<double>(S[i].size())};
+    for (std::size_t k = 0; k < S[i].size(); ++k)
+      omega.x[k] = -spec.axle_sign * (C * (S[i].gyro[k] - sv.modules[i].traits.gyro_bias)).x();
+    const double from = std::max({ref.t.front(), S[i].time(0), m.static_end});
+    const double to = std::min(ref.t.back(), S[i].time(S[i].size() - 1));
+    std::vector<double> v, x, y;
+    for (double t = from; t <= to; t += step) {
+      const double vr = ref_speed(t);
+      if (!std::isfinite(vr)) continue;
+      double yr = 0.0;
+      for (const Sampled& s : yaw_sources) yr += s.at(t);
+      v.push_back(vr);
+      x.push_back(omega.at(t));
+      y.push_back(yaw_sources.empty() ? 0.0 : yr / static_cast<double>(yaw_sources.size()));
+    }
+    v = survey::moving_average(v, smooth);
+    x = survey::moving_average(x, smooth);
+    y = survey::moving_average(y, smooth);
+    std::vector<std::uint8_t> keep(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) keep[k] = v[k] >= o.min_speed;
+    Fit2 f = ls2(v, x, y, keep);
+    if (f.n >= 10) {
+      // Again without the residuals beyond 4 MADs (a jump of the reference, a slipping wheel).
+      std::vector<double> res;
+      for (std::size_t k = 0; k < v.size(); ++k)
+        if (keep[k]) res.push_back(std::abs(v[k] - f.a * x[k] - f.b * y[k]));
+      std::nth_element(res.begin(), res.begin() + static_cast<std::ptrdiff_t>(res.size() / 2), res.end());
+      const double mad = res[res.size() / 2];
+      for (std::size_t k = 0; k < v.size(); ++k)
+        if (keep[k] && std::abs(v[k] - f.a * x[k] - f.b * y[k]) > 4.0 * 1.4826 * mad) keep[k] = 0;
+      f = ls2(v, x, y, keep);
+    }
+    w.epochs = f.n;
+    w.correlation = f.corr;
+    if (f.n >= 100 && f.a > 0.0) {
+      // 1 sigma from five parts of the drive.
+      std::vector<double> parts;
+      const std::size_t len = v.size() / 5;
+      for (int p = 0; p < 5 && len > 0; ++p) {
+        std::vector<std::uint8_t> kp(v.size(), 0);
+        for (std::size_t k = p * len; k < (p + 1) * len; ++k) kp[k] = keep[k];
+        const Fit2 fp = ls2(v, x, y, kp);
+        if (fp.n >= 40 && fp.a > 0.0) parts.push_back(fp.a);
+      }
+      double sd = f.sigma_a;
+      if (parts.size() >= 3) {
+        double mean = 0.0, ss = 0.0;
+        for (double a : parts) mean += a;
+        mean /= static_cast<double>(parts.size());
+        for (double a : parts) ss += (a - mean) * (a - mean);
+        sd = std::max(sd, std::sqrt(ss / static_cast<double>(parts.size() - 1) / static_cast<double>(parts.size())));
+      }
+      w.radius = CalibratedValue{f.a, sd, sd < 0.05 * f.a};
+      if (!w.radius.observed) w.radius.value = spec.wheel_radius;
+    } else {
+      out.notes.push_back(spec.name + fmt(": %.0f epochs faster than %.1f m/s against the reference: the radius is not observed",
+                                          static_cast<double>(f.n), o.min_speed));
+    }
+    out.wheels.push_back(w);
+  }
+
+  // A dead reckoning with the radii in a local frame, aligned onto the reference.
+  Manifest dr = m;
+  for (const WheelRadiusFit& w : out.wheels)
+    if (w.radius.observed)
+      for (auto& s : dr.modules)
+        if (s.name == w.module) s.wheel_radius = w.radius.value;
+  dr.heading_known = false;
+  dr.initial_heading = 0.0;
+  for (std::size_t i = 0; i < modules.size(); ++i)
+    if (sv.modules[i].kind == ModuleKind::kWheel && !sv.modules[i].steered && m.find(modules[i])->kind == ModuleKind::kWheel)
+      out.navigation_modules.push_back(modules[i]);
+  if (out.navigation_modules.empty())
+    for (const auto& name : modules)
+      if (m.find(name)->kind == ModuleKind::kWheel) out.navigation_modules.push_back(name);
+  out.initial_heading = CalibratedValue{m.initial_heading, 0.0, false};
+  out.antenna_forward = CalibratedValue{m.antenna_inV ? m.antenna_inV->x() : 0.0, 0.0, false};
+  out.antenna_right = CalibratedValue{m.antenna_inV ? m.antenna_inV->y() : 0.0, 0.0, false};
+  if (!out.navigation_modules.empty()) {
+    RunRequest req;
+    req.manifest = dr;
+    req.modules = out.navigation_modules;
+    req.calibration = CalibrationMode::kManifest;
+    req.data_checks = false;
+    req.progress = o.progress;
+    req.warn = [&](const std::string&) {};  // the run's own warnings belong to the run, not here
+    eval::PlanarTrack traj;
+    req.on_record = [&](const TrajectoryRecord& r) {
+      traj.t.push_back(r.t);
+      traj.p_ne.push_back(r.p_inN.head<2>());
+      traj.heading.push_back(r.rpy.z());
+    };
+    run_navigation(req);
+    eval::StartAlignmentOptions ao;
+    ao.length = o.align_length;
+    ao.estimate_antenna = o.estimate_antenna;
+    out.alignment = eval::fit_start_alignment(ref, traj, ao);
+    const eval::StartAlignment& a = out.alignment;
+    if (a.found) {
+      out.initial_heading = CalibratedValue{a.yaw, a.yaw_sigma, a.yaw_sigma < 5.0 * kDeg};
+      if (o.estimate_antenna) {
+        out.antenna_forward = CalibratedValue{a.antenna.x(), a.antenna_sigma.x(), a.antenna_sigma.x() < 0.5};
+        out.antenna_right = CalibratedValue{a.antenna.y(), a.antenna_sigma.y(), a.antenna_sigma.y() < 0.5};
+      }
+    } else {
+      out.notes.push_back("the dead reckoning could not be aligned onto the reference (too few common epochs)");
+    }
+  }
+  if (warn)
+    for (const auto& n : out.notes) warn(quote(m.path) + ": " + n);
+  return out;
+}
+
+Manifest apply_reference_calibration(Manifest m, const ReferenceCalibration& cal) {
+  for (const WheelRadiusFit& w : cal.wheels)
+    if (w.radius.observed)
+      for (auto& s : m.modules)
+        if (s.name == w.module) s.wheel_radius = w.radius.value;
+  if (cal.initial_heading.observed) {
+    m.initial_heading = wrap_pi(cal.initial_heading.value);
+    m.heading_known = true;
+  }
+  if (cal.antenna_forward.observed || cal.antenna_right.observed) {
+    Vec3 a = m.antenna_inV ? *m.antenna_inV : Vec3::Zero();
+    if (cal.antenna_forward.observed) a.x() = cal.antenna_forward.value;
+    if (cal.antenna_right.observed) a.y() = cal.antenna_right.value;
+    m.antenna_inV = a;
+  }
+  return m;
+}
+
+std::string reference_calibration_report(const ReferenceCalibration& c) {
+  std::string s = "against the reference (estimate +- 1 sigma, manifest):\n";
+  for (const WheelRadiusFit& w : c.wheels)
+    s += "  " + w.module + fmt(std::string(std::max<int>(1, 12 - static_cast<int>(w.module.size())), ' ').append("wheel radius %.4f +- %.4f m (%.4f)").c_str(),
+                               w.radius.value, w.radius.std, w.manifest_radius) +
+         (w.radius.observed ? fmt("  %.0f epochs, correlation %.4f\n", static_cast<double>(w.epochs), w.correlation)
+                            : std::string("  not observed: manifest kept\n"));
+  const auto& a = c.alignment;
+  s += fmt("  initial heading  %.3f +- %.3f deg", c.initial_heading.value / kDeg, c.initial_heading.std / kDeg) +
+       (c.initial_heading.observed ? fmt("  (dead reckoning of %.0f wheel(s) aligned over %.0f m, residual %.3f m)\n",
+                                         static_cast<double>(c.navigation_modules.size()), a.length, a.rms)
+                                   : std::string("  not observed\n"));
+  s += fmt("  antenna          forward %.3f +- %.3f m, right %.3f +- %.3f m", c.antenna_forward.value, c.antenna_forward.std,
+           c.antenna_right.value, c.antenna_right.std) +
+       (c.antenna_forward.observed ? "\n" : "  (not observed)\n");
+  for (const auto& n : c.notes) s += "  note: " + n + "\n";
+  return s;
+}
+
+std::string reference_calibration_yaml(const ReferenceCalibration& c, const Manifest& m) {
+  auto val = [](const CalibratedValue& v, double scale, double manifest) {
+    return fmt("{estimate: %.6g, std: %.3g, manifest: %.6g, observed: ", v.value * scale, v.std * scale, manifest * scale) +
+           (v.observed ? "true}" : "false}");
+  };
+  std::string s = "reference:\n  wheels:\n";
+  for (const WheelRadiusFit& w : c.wheels)
+    s += "    " + io_detail::json_quote(w.module) + ":\n      wheel_radius_m: " + val(w.radius, 1.0, w.manifest_radius) + "\n";
+  s += "  initial:\n    heading_deg: " + val(c.initial_heading, 1.0 / kDeg, m.initial_heading) + "\n";
+  s += "  vehicle:\n    antenna_forward_m: " + val(c.antenna_forward, 1.0, m.antenna_inV ? m.antenna_inV->x() : 0.0) + "\n";
+  s += "    antenna_right_m: " + val(c.antenna_right, 1.0, m.antenna_inV ? m.antenna_inV->y() : 0.0) + "\n";
+  return s;
+}
+
+}  // namespace wheelins
