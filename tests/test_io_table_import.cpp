@@ -337,6 +337,16 @@ TEST(TableReader, UnparsableValues) {
   EXPECT_EQ(r.summary.rows_kept, 6u);
   EXPECT_EQ(r.summary.faults.first_of(RowFault::kUnparsable).row, 3u);
   EXPECT_HAS(r.summary.faults.first_of(RowFault::kUnparsable).what, "column 2 (gyro[1]): cannot read 'abc' as a number");
+  // A counter outside its wrap, and a time beyond what a double holds in seconds.
+  write_text(dir / "b.csv", "65535,1,2,3,4,5,6\n65536,1,2,3,4,5,6\n3,1,2,3,4,5,6\n1e303,1,2,3,4,5,6\n");
+  const ReadAll c = read_all(dir / "b.csv", parse_column_map("time_wrap=2^16,time_scale=1e6"));
+  EXPECT_EQ(c.summary.faults[RowFault::kUnparsable], 2u);
+  EXPECT_HAS(c.summary.faults.first_of(RowFault::kUnparsable).what, "counter value 65536 is outside [0, 65536)");
+  ASSERT_EQ(c.rows.size(), 2u);
+  EXPECT_EQ(c.rows[1].t, (65536.0 + 3.0) * 1e6);  // wrapped once
+  const ReadAll d = read_all(dir / "b.csv", parse_column_map("time_scale=1e6"));
+  EXPECT_EQ(d.summary.faults[RowFault::kUnparsable], 1u);
+  EXPECT_HAS(d.summary.faults.first_of(RowFault::kUnparsable).what, "1e303 is beyond the seconds a double holds");
 }
 
 TEST(TableReader, NonFiniteSpellings) {

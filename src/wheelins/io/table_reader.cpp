@@ -765,6 +765,13 @@ bool TableReader::Impl::row(std::string_view line, std::uint64_t r, ImuRow& out,
   }
   const double t =
       static_cast<double>((raw + static_cast<long double>(wraps_now) * wrap) * seconds_per_tick);
+  if (!std::isfinite(t)) {  // e.g. 1e300 ticks with time_scale 1e6
+    fault(sum, RowFault::kUnparsable, r, [&] {
+      return label[kT] + ": " + std::string(fields[static_cast<std::size_t>(col[kT])]) +
+             " is beyond the seconds a double holds";
+    });
+    return false;
+  }
   if (have_prev && !(t > prev_t)) {
     fault(sum, RowFault::kTimeNotIncreasing, r, [&] {
       return "time " + format_double(t) + " s " +
