@@ -310,10 +310,10 @@ TEST(TableReader, XsensDotExportWithEveryKindOfBadRow) {
   // 5 of 300 rows (1.7 %) is more than the default limit of 1 %: an error naming it all.
   const std::string e = error_of([&] { read_all(file, column_map_preset("xsens-dot"), 0.01); });
   EXPECT_HAS(e, "IMU2_radial.csv': 5 of 300 data rows (1.67 %) cannot be samples, more than the limit of 1 %");
-  EXPECT_HAS(e, "1 NaN or infinite (first: row 20, line 23: column 5 (Acc_X) is NaN)");
-  EXPECT_HAS(e, "1 all zero (first: row 0, line 3:");
-  EXPECT_HAS(e, "2 beyond range (first: row 60, line 63:");
-  EXPECT_HAS(e, "1 time not increasing (first: row 40, line 43:");
+  EXPECT_HAS(e, "1 NaN or infinite (first: data row 20 (0-based), line 23: column 5 (Acc_X) is NaN)");
+  EXPECT_HAS(e, "1 all zero (first: data row 0 (0-based), line 3:");
+  EXPECT_HAS(e, "2 beyond range (first: data row 60 (0-based), line 63:");
+  EXPECT_HAS(e, "1 time not increasing (first: data row 40 (0-based), line 43:");
 }
 
 TEST(TableReader, WrongColumnCount) {
@@ -551,8 +551,8 @@ TEST(TableReader, TooManyBadRowsOrNoneValid) {
   write_text(dir / "a.csv", csv_rows(50) + "0.5,1,2\n0.51,x,0,0,0,0,0\n" + csv_rows(48, 52));
   const std::string e = error_of([&] { read_all(dir / "a.csv", ColumnMap{}, 0.01); });
   EXPECT_HAS(e, "a.csv': 2 of 100 data rows (2 %) cannot be samples, more than the limit of 1 % (--max-bad-fraction)");
-  EXPECT_HAS(e, "1 wrong column count (first: row 50, line 51: 3 fields, the column map needs 7");
-  EXPECT_HAS(e, "1 unparsable value (first: row 51, line 52: column 1 (gyro[0]): cannot read 'x' as a number)");
+  EXPECT_HAS(e, "1 wrong column count (first: data row 50 (0-based), line 51: 3 fields, the column map needs 7");
+  EXPECT_HAS(e, "1 unparsable value (first: data row 51 (0-based), line 52: column 1 (gyro[0]): cannot read 'x' as a number)");
   EXPECT_EQ(read_all(dir / "a.csv", ColumnMap{}, 0.02).rows.size(), 98u);  // at the limit: accepted
 
   write_text(dir / "b.csv", "t,a,b\n1,2,3\n4,5,6\n");

@@ -194,6 +194,11 @@ std::string table_import_report(const std::vector<ImportedTable>& tables) {
     s += buf;
     s += t.faults.summary() + "\n";
   }
+  for (const auto& t : tables)
+    if (t.faults.total()) {
+      s += "(row: the first row left out of each class, 0-based, the header not counted)\n";
+      break;
+    }
   return s;
 }
 

@@ -59,7 +59,7 @@ std::string RowFaults::summary(bool details) const {
     const RowFaultExample& e = first_of(f);
     s += (s.empty() ? "" : details ? "; " : ", ") + std::to_string(n) + " " + to_string(f);
     if (details)
-      s += " (first: row " + std::to_string(e.row) + ", line " + std::to_string(e.line) + ": " + e.what + ")";
+      s += " (first: data row " + std::to_string(e.row) + " (0-based), line " + std::to_string(e.line) + ": " + e.what + ")";
     else
       s += " (" + std::string(n > 1 ? "first " : "") + "row " + std::to_string(e.row) + ")";
   }
