@@ -83,7 +83,8 @@ struct ColumnMap {
   void validate() const;
   /// A few readable lines: every setting and where the unset ones come from.
   std::string describe() const;
-  /// The compact command-line form (every key), which parse_column_map() reads back to this map.
+  /// The compact command-line form (every key), which parse_column_map() reads back to this
+  /// map (when no column name holds ',' or ':', which that form cannot carry).
   std::string to_string() const;
 
   /// The time's factor to seconds for the unit (unset: s), times time_scale.
