@@ -1,5 +1,7 @@
 // `wheelins import RECORDING --out DIR`: ROS bags (ROS 1 .bag, ROS 2 .db3 / .mcap) into
-// the Wheel-INS layout and a drafted manifest (docs/ros-import.md).
+// the Wheel-INS layout and a drafted manifest (docs/ros-import.md); or vendors' CSV/text
+// tables (`--preset`, `--columns`) into IMU files and a manifest drafted from what the data
+// say (docs/csv-import.md, docs/real-data.md).
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -10,16 +12,50 @@
 #include "cli.hpp"
 #include "wheelins/util/progress.hpp"
 #include "wheelins/io/ros/import.hpp"
+#include "wheelins/run/table_dataset.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace {
 using namespace wheelins;
 
 struct Options {
-  std::string recording, out, odometry, truth, origin, convention = "enu", base_frame = "base_link";
+  std::vector<std::string> recordings;
+  std::string out, odometry, truth, origin, convention = "enu", base_frame = "base_link";
   std::vector<std::string> topics;
+  std::string preset, columns, vehicle_type, vehicle;
+  double max_bad_fraction = 0.01;
   bool receive_time = false, force = false, quiet = false;
 };
+
+int run_tables(const Options& o) {
+  if (!o.topics.empty() || !o.odometry.empty() || o.receive_time)
+    throw InputError("--topic, --odometry and --receive-time are for ROS recordings; tables are imported by --preset/--columns");
+  TableDatasetOptions t;
+  for (const auto& r : o.recordings) t.inputs.push_back(r);
+  t.out_dir = o.out;
+  t.preset = o.preset;
+  t.columns = o.columns;
+  t.max_bad_fraction = o.max_bad_fraction;
+  if (!o.truth.empty()) t.truth = o.truth;
+  t.vehicle_type = o.vehicle_type;
+  if (!o.vehicle.empty()) t.vehicle = o.vehicle;
+  t.overwrite = o.force;
+  t.progress = !o.quiet;
+  t.warn = stderr_sink();
+  const TableDatasetResult r = import_table_dataset(t);
+  std::cout << table_import_report(r.tables);
+  for (const auto& s : r.skipped) std::cout << "  skipped " << s << "\n";
+  if (!r.truth_file.empty())
+    std::printf("  reference %s: %zu records\n", r.truth_file.string().c_str(), r.truth_records);
+  std::cout << "what the data say (every module's notes are comments in the manifest):\n" << survey::survey_report(r.survey);
+  for (const auto& f : r.draft.facts) std::cout << "  " << f << "\n";
+  std::cout << "wrote " << r.manifest_file.string() << "\n";
+  if (!r.draft.todo.empty()) {
+    std::cout << "still to fill in (marked TODO in the file):\n";
+    for (const auto& d : r.draft.todo) std::cout << "  - " << d << "\n";
+  }
+  return 0;
+}
 
 earth::Geodetic parse_origin(const std::string& text) {
   double v[3];
@@ -32,6 +68,14 @@ earth::Geodetic parse_origin(const std::string& text) {
 }
 
 int run(const Options& o) {
+  if (!o.preset.empty() || !o.columns.empty() || (!o.recordings.empty() && looks_like_tables(o.recordings.front())))
+    return run_tables(o);
+  if (o.recordings.size() != 1)
+    throw InputError("a ROS recording is imported one at a time (" + std::to_string(o.recordings.size()) +
+                     " given); several tables need --preset or --columns");
+  if (!o.vehicle_type.empty() || !o.vehicle.empty())
+    throw InputError("--vehicle-type and --vehicle are for tables (--preset/--columns)");
+  const std::string& recording = o.recordings.front();
   ros::ImportOptions opt;
   for (const auto& t : o.topics) {
     const auto eq = t.find('=');
@@ -55,9 +99,9 @@ int run(const Options& o) {
     bar->update(done);
   };
 
-  const ros::ImportResult r = ros::import_recording(o.recording, o.out, opt);
+  const ros::ImportResult r = ros::import_recording(recording, o.out, opt);
   if (bar) bar->finish();
-  std::cout << "imported " << o.recording << " (" << r.format << ")\n";
+  std::cout << "imported " << recording << " (" << r.format << ")\n";
   for (const auto& t : r.imu)
     std::printf("  %-28s -> %s: %llu samples, %.3f .. %.3f s%s\n", t.topic.c_str(), t.file.string().c_str(),
                 static_cast<unsigned long long>(t.messages), t.t_first, t.t_last,
@@ -75,18 +119,32 @@ int run(const Options& o) {
 }
 
 const bool registered = cli::register_command(
-    16, "import", "Import a ROS recording (ROS 1 .bag, ROS 2 .db3/.mcap) as a dataset with a drafted manifest",
+    16, "import",
+    "Import a ROS recording (ROS 1 .bag, ROS 2 .db3/.mcap) or vendors' CSV tables as a dataset with a drafted manifest",
     [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
-      sub.add_option("RECORDING", o->recording, "ROS 1 .bag, ROS 2 .db3 or .mcap file, or a ROS 2 bag directory")
+      sub.add_option("RECORDING", o->recordings,
+                     "ROS 1 .bag, ROS 2 .db3 or .mcap file, or a ROS 2 bag directory; or CSV/text tables "
+                     "(files, or directories of *.csv / *.txt), one IMU each")
           ->required();
+      sub.add_option("--preset", o->preset, "tables: the column map preset: xsens-dot | csv (docs/csv-import.md)");
+      sub.add_option("--columns", o->columns, "tables: a column map (MAP.yaml or a string) refining the preset");
+      sub.add_option("--max-bad-fraction", o->max_bad_fraction,
+                     "tables: the largest fraction of a table's rows that may be left out as faults")
+          ->capture_default_str();
+      sub.add_option("--vehicle-type", o->vehicle_type,
+                     "tables: car | robot: the typical values written where the data cannot tell (default car)");
+      sub.add_option("--vehicle", o->vehicle,
+                     "tables: a calibrated manifest of the same vehicle: its radii, mountings, lever arms, "
+                     "positions and antenna are used for modules of the same name");
       sub.add_option("--out,-o", o->out, "Output dataset directory (empty or new)")->required();
       sub.add_option("--topic", o->topics,
                      "MODULE=TOPIC: import this sensor_msgs/Imu topic as module MODULE (repeatable; "
                      "default: every Imu topic, named after it)");
       sub.add_option("--odometry", o->odometry, "nav_msgs/Odometry topic whose twist.linear.x becomes odo.bin");
       sub.add_option("--truth", o->truth,
-                     "nav_msgs/Odometry or geometry_msgs/PoseStamped topic that becomes the truth GINS.bin");
+                     "ROS: nav_msgs/Odometry or geometry_msgs/PoseStamped topic that becomes the truth GINS.bin; "
+                     "tables: a reference track file (GNSS CSV with time, lat, lon, height; TUM; Wheel-INS binary)");
       sub.add_option("--origin", o->origin,
                      "LAT_DEG,LON_DEG,H_M of the truth frame's origin (default: a 0,0,0 placeholder)");
       sub.add_option("--truth-frame", o->convention,

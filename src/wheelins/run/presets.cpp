@@ -2,6 +2,7 @@
 #include "wheelins/run/presets.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "wheelins/nav/types.hpp"
 
@@ -46,13 +47,13 @@ std::vector<std::string> configuration_modules(const Manifest& m, const std::str
                      " chips (one per IMU), " + std::to_string(chips.size()) + " given");
   std::vector<std::string> out;
   for (std::size_t i = 0; i < slots.size(); ++i) {
+    // Of several candidates, the wheel nearest the rear axle (x = 0: an unsteered wheel of a
+    // car whose front wheels steer), the first listed among equals.
     const ModuleSpec* pick = nullptr;
     for (const auto& mod : m.modules) {
       if (!in_slot(mod, slots[i])) continue;
-      if (chips.empty() || mod.chip == chips[i] || mod.name == chips[i]) {
-        pick = &mod;
-        break;
-      }
+      if (chips.empty() || mod.chip == chips[i] || mod.name == chips[i])
+        if (!pick || std::abs(mod.p_inV.x()) < std::abs(pick->p_inV.x())) pick = &mod;
     }
     // A lone Wheel-IMU (a manifest with no left one, e.g. the public single-IMU layout with
     // its wheel on the right) serves as the configuration's wheel when there is no right slot.

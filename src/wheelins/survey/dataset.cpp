@@ -409,4 +409,25 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
   return out;
 }
 
+std::string survey_report(const DatasetSurvey& s) {
+  std::string out = "module          kind   axle     side   steered        clock offset [s]\n";
+  for (const ModuleFinding& f : s.modules) {
+    char line[256];
+    const bool w = f.kind == ModuleKind::kWheel;
+    std::string axle = w ? std::string(1, "xyz"[f.axle_axis]) + (f.forward_clear ? (f.axle_sign > 0 ? " right" : " left") : " ?") : "-";
+    std::string side = w ? (f.side > 0 ? "right" : f.side < 0 ? "left" : "?") : "-";
+    std::string steer = !w ? "-" : std::isfinite(f.yaw_lead) ? (f.steered ? "yes" : "no") + fmt(" (%+.2f s)", f.yaw_lead) : "?";
+    std::string clock = f.clock_reference ? "0 (the reference)"
+                        : f.clock.found   ? fmt("%+.4f +- %.4f", f.clock.offset, f.clock.sigma)
+                                          : "not found";
+    std::snprintf(line, sizeof line, "%-15s %-6s %-8s %-6s %-14s %s\n", f.module.c_str(), w ? "wheel" : "body",
+                  axle.c_str(), side.c_str(), steer.c_str(), clock.c_str());
+    out += line;
+  }
+  out += s.static_period ? fmt("static period %.2f .. %.2f s (%.1f s, every wheel at rest)\n", s.static_period->start,
+                               s.static_period->end, s.static_period->length())
+                         : std::string("no static period (the modules never rest together)\n");
+  return out;
+}
+
 }  // namespace wheelins::survey

@@ -87,6 +87,10 @@ struct DatasetSurvey {
   const ModuleFinding* find(const std::string& name) const;
 };
 
+/// A readable table: per module its kind, axle axis and the way forward, side, steering and
+/// clock offset, and the static period.
+std::string survey_report(const DatasetSurvey& survey);
+
 /// Reads the modules' files (bounded, survey/series.hpp) and surveys them.
 DatasetSurvey survey_modules(const std::vector<ModuleInput>& modules, const SurveyOptions& options = {});
 

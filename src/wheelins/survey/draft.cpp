@@ -11,6 +11,9 @@ namespace {
 
 constexpr const char* kTodo = "TODO: measure";
 
+/// x rounded to a multiple of q (the precision the data give: the manifest stays readable).
+double round_to(double x, double q) { return std::round(x / q) * q; }
+
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
   char buf[200];
   std::snprintf(buf, sizeof buf, f, a, b, c);
@@ -67,7 +70,7 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
     s.gyro_range = in.gyro_range;
     s.accel_range = in.accel_range;
     s.noise_stated = 0;
-    s.time_offset = in.input_offset + (f->clock.found ? f->clock.offset : 0.0);
+    s.time_offset = round_to(in.input_offset + (f->clock.found ? f->clock.offset : 0.0), 1e-4);
     if (f->clock_reference)
       note[key + "time_offset_s"] = "the reference clock";
     else if (f->clock.found)
@@ -131,6 +134,7 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
       C.row(1) = right.transpose();
       C.row(2) = down.transpose();
       s.mounting_rpy = euler_from_dcm(C);
+      for (int k = 0; k < 3; ++k) s.mounting_rpy[k] = round_to(s.mounting_rpy[k] / kDeg, 0.01) * kDeg;
       note[key + "mounting_deg"] = f->axes_found
                                        ? fmt("from the data: up-axis at rest, forward axis from accelerations (fit %.2f); refined by every run", f->forward_fit)
                                        : "roll, pitch from the data; yaw TODO (no clear forward acceleration)";
@@ -149,8 +153,8 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
 
   // The static period and the start.
   if (survey.static_period) {
-    m.static_start = survey.static_period->start;
-    m.static_end = survey.static_period->end;
+    m.static_start = round_to(survey.static_period->start, 0.01);
+    m.static_end = round_to(survey.static_period->end, 0.01);
     note["static_period_s"] = "from the data: every wheel at rest, on the reference clock";
   } else {
     d.todo.push_back("static_period_s: the modules never rest together at the start (a static period is needed to align)");
@@ -174,7 +178,7 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
   if (o.truth_file) {
     m.truth_file = *o.truth_file;
     if (o.truth_clock && o.truth_clock->found) {
-      m.truth_time_offset = o.truth_clock->offset;
+      m.truth_time_offset = round_to(o.truth_clock->offset, 1e-4);
       note["truth_time_offset_s"] = fmt("from the data: +- %.3f s (its speed against the wheels', correlation %.4f)",
                                         o.truth_clock->sigma, o.truth_clock->correlation);
     } else {
@@ -188,7 +192,6 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
   if (lever_todo) d.todo.push_back("wheel position_v_m (x, y) and vehicle.track_m, vehicle.wheelbase_m: typical values written");
   if (body_pos_todo) d.todo.push_back("body position_v_m: a typical value written (a run refines it relative to the wheels)");
   if (side_todo) d.todo.push_back("which side each wheel is on (y of position_v_m): not told by the data (one wheel, or no turns)");
-  d.facts.insert(d.facts.end(), survey.notes.begin(), survey.notes.end());
   if (o.truth_clock)
     for (const auto& n : o.truth_clock->notes) d.facts.push_back("reference clock: " + n);
   d.notes.header = {"drafted by `wheelins import` from " + o.source,
