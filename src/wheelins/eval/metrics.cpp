@@ -328,7 +328,7 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
   src.truth_file = truth.file.string();
   src.traj_file = traj.file.string();
   src.traj_format = trajectory_format_name(traj.format);
-  src.truth_has_attitude = truth.has_velocity_attitude;
+  src.truth_has_attitude = truth.has_attitude;
   src.traj_has_lla = traj.has_lla;
   src.traj_has_heading = traj.has_heading;
   src.traj_has_sigma = traj.has_pos_std;
