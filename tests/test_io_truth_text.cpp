@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "io_test_util.hpp"
+#include "wheelins/eval/truth_quality.hpp"
 #include "wheelins/io/binary.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/io/truth_text.hpp"
@@ -373,4 +374,17 @@ TEST(IoTruthText, RealCarGnssCsv) {
                 .head<2>()
                 .norm();
   EXPECT_NEAR(path, 527.0, 3.0);
+  const eval::TruthQualityReport q = eval::check_truth_quality(d);
+  EXPECT_NEAR(q.median_interval, 0.2, 0.011);
+  EXPECT_EQ(q.gap_count, 0u);
+  EXPECT_EQ(q.jump_count, 0u);
+  EXPECT_EQ(q.repeated, 0u);  // collapsed on read
+  // Read raw (every row a record, 0.01 s apart), the repeats show as stalls.
+  TruthReadOptions raw = scaled(0.1);
+  raw.collapse_repeated = false;
+  const eval::TruthQualityReport qr = eval::check_truth_quality(read_truth(file, TruthLayout::kText, raw));
+  EXPECT_EQ(qr.records, 13372u);
+  EXPECT_EQ(qr.repeated, 13372u - d.records.size());
+  EXPECT_GT(qr.stall_count, 600u);
+  EXPECT_EQ(qr.jump_count, 0u);
 }
