@@ -11,6 +11,7 @@
 #include "cli.hpp"
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/truth_text.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace {
@@ -24,9 +25,13 @@ struct Options {
   bool align = false;
   bool force = false;
   std::string json, series, origin;
+  std::string antenna, truth_columns, truth_frame = "enu", truth_origin;
+  double truth_time_scale = 1.0, truth_time_offset = 0.0;
+  bool truth_keep_repeats = false;
 };
 
-earth::Geodetic parse_origin(const std::string& text) {
+// "a,b,c" as three finite numbers; `flag` and `expected` name them in the messages.
+std::vector<double> parse_three(const std::string& flag, const std::string& text, const char* expected) {
   std::vector<double> v;
   std::size_t start = 0;
   while (start <= text.size()) {
@@ -38,17 +43,21 @@ earth::Geodetic parse_origin(const std::string& text) {
     const auto r = std::from_chars(part.data(), part.data() + part.size(), x);
     if (part.empty() || r.ec != std::errc() || r.ptr != part.data() + part.size() ||
         !std::isfinite(x))
-      throw InputError("--origin '" + text + "': '" + part +
-                       "' is not a number (expected lat_deg,lon_deg,h_m)");
+      throw InputError(flag + " '" + text + "': '" + part + "' is not a number (expected " + expected + ")");
     v.push_back(x);
     if (k == std::string::npos) break;
     start = k + 1;
   }
   if (v.size() != 3)
-    throw InputError("--origin '" + text + "': expected 3 values lat_deg,lon_deg,h_m, got " +
+    throw InputError(flag + " '" + text + "': expected 3 values " + expected + ", got " +
                      std::to_string(v.size()));
+  return v;
+}
+
+earth::Geodetic parse_geodetic(const std::string& flag, const std::string& text) {
+  const std::vector<double> v = parse_three(flag, text, "lat_deg,lon_deg,h_m");
   if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 180.0)
-    throw InputError("--origin '" + text + "': latitude/longitude out of range");
+    throw InputError(flag + " '" + text + "': latitude/longitude out of range");
   return {v[0] * kDeg, v[1] * kDeg, v[2]};
 }
 
@@ -59,7 +68,7 @@ std::string fmt(double v, int decimals, const char* unit = "") {
   return buf;
 }
 
-void print_table(std::ostream& os, const eval::EvalResult& r, const std::string& truth_layout) {
+void print_table(std::ostream& os, const eval::EvalResult& r, const TruthData& truth) {
   auto row = [&](const char* name, const std::string& value) {
     char buf[48];
     std::snprintf(buf, sizeof(buf), "  %-26s", name);
@@ -67,12 +76,26 @@ void print_table(std::ostream& os, const eval::EvalResult& r, const std::string&
   };
   os << "trajectory: " << r.traj_file << " (" << r.traj_format << ", " << r.traj_records
      << " records)\n";
-  os << "truth:      " << r.truth_file << " (" << truth_layout << ", " << r.truth_records
-     << " records)\n";
+  os << "truth:      " << r.truth_file << " (" << truth_layout_name(truth.layout) << ", "
+     << r.truth_records << " records)\n";
+  if (!truth.description.empty()) os << "            " << truth.description << "\n";
+  std::string applied;
+  if (!r.antenna.isZero())
+    applied += "antenna at " + fmt(r.antenna.x(), 3) + " / " + fmt(r.antenna.y(), 3) + " / " +
+               fmt(r.antenna.z(), 3) + " m (forward / right / down) from the trajectory's point";
+  if (r.truth_time_offset != 0.0)
+    applied += std::string(applied.empty() ? "" : "; ") + "truth time offset " +
+               (r.truth_time_offset > 0 ? "+" : "") + fmt(r.truth_time_offset, 6, " s");
+  os << "applied:    " << (applied.empty() ? std::string("no antenna lever arm, no truth time offset") : applied)
+     << "\n";
+  os << "truth quality: " << eval::describe_truth_quality(r.truth_quality);
   std::string epochs = std::to_string(r.epochs) + " truth epochs";
-  if (r.skipped_outside || r.skipped_gap)
+  if (r.skipped_outside || r.skipped_gap || r.skipped_truth_jump) {
     epochs += " (" + std::to_string(r.skipped_outside) + " outside the trajectory, " +
-              std::to_string(r.skipped_gap) + " in gaps)";
+              std::to_string(r.skipped_gap) + " in its gaps";
+    if (r.skipped_truth_jump) epochs += ", " + std::to_string(r.skipped_truth_jump) + " left out at truth jumps";
+    epochs += ")";
+  }
   row("evaluated", epochs);
   row("duration", fmt(r.duration, 2, " s") + "  (" + fmt(r.t_start, 3) + " .. " +
                       fmt(r.t_end, 3) + ")");
@@ -84,9 +107,19 @@ void print_table(std::ostream& os, const eval::EvalResult& r, const std::string&
     drift += "  (mean of " + std::to_string(r.drift_curve.size()) + " segments of " +
              fmt(r.segment_length, 0, " m") + ")";
   row("position drift rate", drift);
-  row("heading RMSE", r.has_heading ? fmt(r.heading_rmse / kDeg, 3, " deg") +
-                                          "  (max " + fmt(r.heading_max_abs / kDeg, 2, " deg") + ")"
-                                    : "n/a (no heading in truth or trajectory)");
+  row("final error / distance", fmt(r.final_error_ratio * 100.0, 3, " %"));
+  if (r.heading_source == "course") {
+    row("heading RMSE (course)",
+        r.has_heading ? fmt(r.heading_rmse / kDeg, 3, " deg") + "  (from the course: the truth has no heading; max " +
+                            fmt(r.heading_max_abs / kDeg, 2, " deg") + ", " + std::to_string(r.heading_epochs) +
+                            " epochs moving >= 1 m/s)"
+                      : std::string("n/a (the truth has no heading and its course was never usable: "
+                                    "slower than 1 m/s)"));
+  } else {
+    row("heading RMSE", r.has_heading ? fmt(r.heading_rmse / kDeg, 3, " deg") +
+                                            "  (max " + fmt(r.heading_max_abs / kDeg, 2, " deg") + ")"
+                                      : "n/a (no heading in truth or trajectory)");
+  }
   row("max horizontal error", fmt(r.max_error, 3, " m"));
   row("final horizontal error", fmt(r.final_error, 3, " m"));
   row("RMS horizontal error", fmt(r.rms_error, 3, " m"));
@@ -129,14 +162,35 @@ const bool registered = cli::register_command(
     30, "evaluate", "Accuracy of a trajectory against a truth file (drift rate, heading RMSE)",
     [](CLI::App& sub) {
       auto o = std::make_shared<Options>();
-      sub.add_option("--truth", o->truth, "Truth file: GINS.bin (11 or 5 float64 columns)")
+      sub.add_option("--truth", o->truth,
+                     "Truth file: GINS.bin (11 or 5 float64 columns), a GNSS track as CSV/text "
+                     "(time, lat, lon, height columns by header name) or a TUM file")
           ->required();
       sub.add_option("--traj", o->traj, "Trajectory to judge (wheelins CSV, TUM, Wheel-INS traj.txt)")
           ->required();
       sub.add_option("--format", o->format, "Trajectory format: auto|csv|tum|wheelins-traj")
           ->capture_default_str();
-      sub.add_option("--truth-layout", o->truth_layout, "Truth layout: auto|gins11|pos5")
+      sub.add_option("--truth-layout", o->truth_layout, "Truth layout: auto|gins11|pos5|text|tum")
           ->capture_default_str();
+      sub.add_option("--truth-columns", o->truth_columns,
+                     "Text truth columns TIME,LAT,LON,HEIGHT (header names or 0-based indices; "
+                     "default: found by header name)");
+      sub.add_option("--truth-time-scale", o->truth_time_scale,
+                     "Multiplies the truth's times on read (e.g. 0.1 for a column counting tenths of a second)")
+          ->capture_default_str();
+      sub.add_option("--truth-time-offset", o->truth_time_offset, "Added to the truth's times [s]")
+          ->capture_default_str();
+      sub.add_flag("--truth-keep-repeats", o->truth_keep_repeats,
+                   "Text truth: keep rows repeating the previous fix (default: one fix, at its first row)");
+      sub.add_option("--truth-frame", o->truth_frame,
+                     "TUM truth: its local frame, enu (body x forward, y left, z up; ROS, evo) or ned "
+                     "(body x forward, y right, z down)")
+          ->capture_default_str();
+      sub.add_option("--truth-origin", o->truth_origin,
+                     "TUM truth: the geodetic origin of its local frame, lat_deg,lon_deg,h_m");
+      sub.add_option("--antenna", o->antenna,
+                     "The truth's antenna in the vehicle frame from the trajectory's point, x,y,z [m] "
+                     "(x forward, y right, z down)");
       sub.add_option("--segment", o->segment, "Drift-rate segment length l [m]")
           ->capture_default_str();
       sub.add_option("--max-gap", o->max_gap,
@@ -156,6 +210,10 @@ const bool registered = cli::register_command(
           throw InputError("--segment " + std::to_string(o->segment) + ": must be in [1, 1e6] m");
         if (!(o->max_gap > 0.0 && o->max_gap <= 3600.0))
           throw InputError("--max-gap " + std::to_string(o->max_gap) + ": must be in (0, 3600] s");
+        if (!(std::isfinite(o->truth_time_scale) && o->truth_time_scale > 0.0))
+          throw InputError("--truth-time-scale " + std::to_string(o->truth_time_scale) + ": must be > 0");
+        if (!std::isfinite(o->truth_time_offset))
+          throw InputError("--truth-time-offset: must be a finite number of seconds");
         const TruthLayout layout = truth_layout_from_name(o->truth_layout);
         const TrajectoryFormat format = trajectory_format_from_name(o->format);
         if (format == TrajectoryFormat::kKml)
@@ -163,19 +221,38 @@ const bool registered = cli::register_command(
         if (!o->json.empty() && o->json != "-") check_output_target(o->json, o->force);
         if (!o->series.empty()) check_output_target(o->series, o->force);
 
-        const TruthData truth = read_truth(o->truth, layout);
-        const TrajectoryData traj = read_trajectory(o->traj, format);
-        const earth::LocalFrame frame(o->origin.empty() ? truth.records.front().lla
-                                                        : parse_origin(o->origin));
+        TruthReadOptions read;
+        read.time_scale = o->truth_time_scale;
+        read.collapse_repeated = !o->truth_keep_repeats;
+        if (!o->truth_columns.empty()) set_truth_columns(read, o->truth_columns);
+        read.tum_frame = tum_frame_from_name(o->truth_frame);
+        if (!o->truth_origin.empty()) read.tum_origin = parse_geodetic("--truth-origin", o->truth_origin);
         eval::EvalOptions opt;
         opt.segment_length = o->segment;
         opt.max_gap = o->max_gap;
         opt.align = o->align;
+        opt.truth_time_offset = o->truth_time_offset;
+        if (!o->antenna.empty()) {
+          const std::vector<double> l = parse_three("--antenna", o->antenna, "x,y,z in metres");
+          opt.antenna = Vec3(l[0], l[1], l[2]);
+        }
+
+        const TruthLayout found = layout == TruthLayout::kAuto ? detect_truth_layout(o->truth) : layout;
+        if (found != TruthLayout::kTum && (!o->truth_origin.empty() || o->truth_frame != "enu"))
+          throw InputError("--truth-origin and --truth-frame are for a TUM truth; '" + o->truth +
+                           "' is " + truth_layout_name(found));
+        if (found != TruthLayout::kText && (!o->truth_columns.empty() || o->truth_keep_repeats))
+          throw InputError("--truth-columns and --truth-keep-repeats are for a text truth; '" + o->truth +
+                           "' is " + truth_layout_name(found));
+        const TruthData truth = read_truth(o->truth, found, read);
+        const TrajectoryData traj = read_trajectory(o->traj, format);
+        const earth::LocalFrame frame(o->origin.empty() ? truth.records.front().lla
+                                                        : parse_geodetic("--origin", o->origin));
         const eval::EvalResult res = eval::evaluate(truth, traj, frame, opt);
 
         // With JSON on stdout the table goes to stderr, so stdout stays parseable.
         std::ostream& table = o->json == "-" ? std::cerr : std::cout;
-        print_table(table, res, truth_layout_name(truth.layout));
+        print_table(table, res, truth);
         if (!traj.records.empty()) {
           const double span = traj.records.back().t - traj.records.front().t;
           if (res.duration < 0.95 * span - 1.0)

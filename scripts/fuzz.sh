@@ -9,8 +9,8 @@ build=${2:-build-fuzz}
 cd "$(dirname "$0")/.."
 CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_FUZZ=ON \
   -DWHEELINS_BUILD_TESTS=OFF -DWHEELINS_BUILD_BENCH=OFF > /dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz_imu_file fuzz_truth fuzz_config fuzz_mcap fuzz_table
-for target in imu_file truth config mcap table; do
+cmake --build "$build" -j"$(nproc)" --target fuzz_imu_file fuzz_truth fuzz_truth_text fuzz_config fuzz_mcap fuzz_table
+for target in imu_file truth truth_text config mcap table; do
   corpus_seed="fuzz/corpus/${target%_file}"
   work="$build/corpus-$target"
   mkdir -p "$work"

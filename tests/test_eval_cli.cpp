@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -167,4 +168,93 @@ TEST_F(EvalCliTest, BadInputExitsTwo) {
       run("--truth " + p("GINS.bin") + " --traj " + p("traj.csv") + " --origin 30,abc,0");
   EXPECT_EQ(origin.code, 2);
   EXPECT_NE(origin.err.find("--origin"), std::string::npos);
+}
+
+// A GNSS log as the car's (Timestamp in tenths of a second, a 5 Hz fix repeated at 100 Hz)
+// given directly as the truth, its clock 50 s behind, its antenna 1 m ahead of and 1.5 m
+// above the trajectory's point; the trajectory drives north at 5 m/s with its heading 1 deg
+// off. The heading comes from the course.
+TEST_F(EvalCliTest, GnssCsvTruthWithTimeScaleOffsetAntennaAndCourse) {
+  const earth::Geodetic origin{32.7655 * kDeg, 35.0136 * kDeg, 450.0};
+  const earth::LocalFrame frame(origin);
+  {
+    std::ofstream csv(dir_ / "GNSS.csv");
+    csv << "Timestamp,Lat_GNSS,Long_GNSS,Height_GNSS,Acc_X\n";
+    for (int row = 0; row <= 12000; ++row) {
+      const double t = 0.2 * (row / 20);
+      const earth::Geodetic g = frame.geodetic_from_ned(Vec3(5.0 * t + 1.0, 0, -1.5));
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%.1f,%.10f,%.10f,%.4f,0.01\n", 0.1 * row, g.lat / kDeg, g.lon / kDeg, g.h);
+      csv << buf;
+    }
+    auto w = make_trajectory_writer(TrajectoryFormat::kCsv, dir_ / "traj.csv");
+    for (int i = 0; i <= 2400; ++i) {
+      TrajectoryRecord r;
+      r.t = 50.0 + 0.05 * i;
+      r.p_inN = Vec3(5.0 * 0.05 * i, 0, 0);
+      r.lla = frame.geodetic_from_ned(r.p_inN);
+      r.rpy = Vec3(0, 0, 1.0 * kDeg);
+      w->write(r);
+    }
+    w->commit();
+  }
+  const std::string base = "--truth " + p("GNSS.csv") + " --traj " + p("traj.csv") +
+                           " --truth-time-scale 0.1 --truth-time-offset 50 --json -";
+  const CmdResult r = run(base + " --antenna 1,0,-1.5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"truth_layout\": \"text\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"heading_source\": \"course\""), std::string::npos) << r.out;
+  EXPECT_NEAR(json_value(r.out, "truth_records"), 601.0, 0.0);
+  EXPECT_NEAR(json_value(r.out, "epochs"), 601.0, 0.0);
+  EXPECT_NEAR(json_value(r.out, "heading_rmse_deg"), 1.0, 1e-6);
+  // The lever arm turned by the 1 deg heading error: 1 m x sin(1 deg) to the side.
+  EXPECT_NEAR(json_value(r.out, "max_error_m"), std::sin(1.0 * kDeg), 1e-4);
+  EXPECT_NEAR(json_value(r.out, "final_error_over_distance_pct"), 100.0 * std::sin(1.0 * kDeg) / 600.0, 1e-5);
+  EXPECT_NEAR(json_value(r.out, "truth_time_offset_s"), 50.0, 0.0);
+  EXPECT_NE(r.err.find("text: columns: time 'Timestamp' (0) x 0.1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("12001 rows, 11400 repeating the fix before them, 601 fixes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("antenna at 1.000 / 0.000 / -1.500 m"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("truth time offset +50"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("truth quality: no gaps, jumps or repeated fixes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("from the course"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("final error / distance"), std::string::npos) << r.err;
+
+  // Without the lever arm the antenna is 1 m ahead of the trajectory's point.
+  const CmdResult no_arm = run(base);
+  ASSERT_EQ(no_arm.code, 0) << no_arm.err;
+  EXPECT_NEAR(json_value(no_arm.out, "max_error_m"), 1.0, 1e-4);
+  // TUM options on a text truth, and a bad antenna, are refused.
+  const CmdResult tum_opt = run(base + " --truth-origin 30,114,0");
+  EXPECT_EQ(tum_opt.code, 2);
+  EXPECT_NE(tum_opt.err.find("for a TUM truth"), std::string::npos) << tum_opt.err;
+  const CmdResult bad_arm = run(base + " --antenna 1,0");
+  EXPECT_EQ(bad_arm.code, 2);
+  EXPECT_NE(bad_arm.err.find("--antenna"), std::string::npos) << bad_arm.err;
+}
+
+// A TUM truth in NED (what wheelins writes) about a given origin: the attitude is the truth's
+// heading; without the origin it cannot be placed.
+TEST_F(EvalCliTest, TumTruthWithFrameAndOrigin) {
+  make_files();
+  const earth::Geodetic origin{30.5 * kDeg, 114.3 * kDeg, 20.0};
+  const earth::LocalFrame frame(origin);
+  auto w = make_trajectory_writer(TrajectoryFormat::kTum, dir_ / "truth.tum");
+  for (int i = 0; i <= 300; ++i) {
+    TrajectoryRecord t;
+    t.t = 1000.0 + i;
+    t.p_inN = Vec3(i, 0, 0);
+    w->write(t);
+  }
+  w->commit();
+  const CmdResult r = run("--truth " + p("truth.tum") + " --traj " + p("traj.csv") +
+                          " --truth-frame ned --truth-origin 30.5,114.3,20 --json -");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"truth_layout\": \"tum\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"heading_source\": \"truth\""), std::string::npos) << r.out;
+  EXPECT_NEAR(json_value(r.out, "drift_rate_pct"), 1.0, 1e-6);
+  EXPECT_NEAR(json_value(r.out, "heading_rmse_deg"), 1.0, 1e-6);
+  EXPECT_NE(r.err.find("TUM in NED (body FRD)"), std::string::npos) << r.err;
+  const CmdResult no_origin = run("--truth " + p("truth.tum") + " --traj " + p("traj.csv"));
+  EXPECT_EQ(no_origin.code, 2);
+  EXPECT_NE(no_origin.err.find("origin"), std::string::npos) << no_origin.err;
 }

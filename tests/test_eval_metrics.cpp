@@ -141,7 +141,7 @@ TEST(EvalMetrics, InterpolatesTrajectoryToTruthTimes) {
   }
   TruthData truth;
   truth.file = "truth.bin";
-  truth.has_velocity_attitude = false;
+  truth.has_velocity = truth.has_attitude = false;
   truth.layout = TruthLayout::kPos5;
   const double ts[4] = {-1.0, 0.25, 1.5, 3.0};  // the first and last lie outside
   const Vec3 ps[4] = {{0, 0, 0}, {2.5, 1, 0}, {10, 5, 0}, {10, 10, 0}};

@@ -133,7 +133,7 @@ TEST(IoTruth, WriterRoundTripIsExact) {
   EXPECT_FALSE(iotest::partial_left(file));
   const TruthData d = read_truth(file);
   EXPECT_EQ(d.layout, TruthLayout::kGins11);
-  EXPECT_TRUE(d.has_velocity_attitude);
+  EXPECT_TRUE(d.has_velocity_attitude());
   EXPECT_EQ(d.gps_week, 2100.0);
   ASSERT_EQ(d.records.size(), recs.size());
   for (std::size_t i = 0; i < recs.size(); ++i) {
@@ -172,7 +172,9 @@ TEST(IoTruth, FiveColumnLayout) {
                        {11.0, 30.1000002, 114.2000001, 20.2, 7.0}});
   const TruthData d = read_truth(file);
   EXPECT_EQ(d.layout, TruthLayout::kPos5);
-  EXPECT_FALSE(d.has_velocity_attitude);
+  EXPECT_FALSE(d.has_velocity_attitude());
+  EXPECT_FALSE(d.has_velocity);
+  EXPECT_FALSE(d.has_attitude);
   ASSERT_EQ(d.records.size(), 3u);
   EXPECT_EQ(d.records[1].t, 10.5);
   EXPECT_NEAR(d.records[1].lla.lat, 30.1000001 * kDeg, 1e-15);

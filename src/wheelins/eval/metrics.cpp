@@ -18,6 +18,7 @@ namespace wheelins::eval {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTimeSlack = 1e-6;  // [s] end-point tolerance of the time brackets
 
 std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
@@ -49,30 +50,61 @@ std::vector<double> drift_rate_curve(const std::vector<double>& s, const std::ve
 
 // ------------------------------------------------------------------ Evaluator
 
+// The truth records go through three stages, each in time order, joined by their index:
+//   1. on arrival: the quality verdict (truth_quality.hpp) and the path length;
+//   2. matching: the trajectory interpolated to the record's time once two trajectory
+//      samples bracket it (or it is known to lie outside / in a trajectory gap);
+//   3. the course (only when the truth has no attitude): once a good fix course_baseline / 2
+//      later has arrived (or a break, or the end).
+// A record is scored when stages 2 and 3 are done; records leave in order, so the memory
+// is the records within course_baseline / 2 plus those between two trajectory samples.
 struct Evaluator::State {
-  struct Sample {  // one trajectory record, positions in the evaluation frame
+  struct Sample {  // one trajectory record, positions in the evaluation frame (at the antenna)
     double t = 0.0;
     Vec3 p = Vec3::Zero();
     double heading = kNaN, sn = kNaN, se = kNaN;
+    double yaw_rate = 0.0;   // [rad/s] over the interval ending here
+    double lever_fwd = 0.0;  // [m] the antenna's forward offset, levelled (roll and pitch taken off)
   };
-  struct Truth {  // one truth record with its position and path length
+  enum class Match { kWaiting, kEpoch, kOutside, kGap };
+  struct Slot {  // one truth record on its way
     double t = 0.0, heading = kNaN, s = 0.0;
     Vec3 p = Vec3::Zero();
+    bool bad = false;
+    Match match = Match::kWaiting;
+    Vec3 traj_p = Vec3::Zero();  // the interpolated trajectory
+    double traj_heading = kNaN, sn = kNaN, se = kNaN, yaw_rate = 0.0, lever_fwd = 0.0;
+    bool course_done = false;
+    double course = kNaN, course_speed = kNaN;
+  };
+  struct CourseFix {  // a good distinct truth fix for the course
+    double t = 0.0;
+    Vec3 p = Vec3::Zero();
+    std::uint64_t breaks = 0;  // breaks (gaps, steps) up to and including this fix
   };
 
   earth::LocalFrame frame;
   Sources src;
   EvalOptions opt;
   bool keep_series = false;
+  bool use_course = false;
   EvalResult res;
+  TruthQualityMonitor quality;
 
   Sample a, b;          // the last two trajectory samples (b the latest)
   std::size_t n_traj = 0;
   bool traj_ended = false;  // end_trajectory() was called
   double first_traj_t = 0.0;
-  std::deque<Truth> pending;
+
+  std::deque<Slot> slots;        // slots.front() has index `base`
+  std::uint64_t base = 0;        // index of slots.front()
+  std::uint64_t next_match = 0;  // the first slot still waiting for the trajectory
+  std::uint64_t next_course = 0; // the first slot whose course is not done
+  std::deque<CourseFix> course_fixes;
+  std::uint64_t breaks = 0;      // breaks seen so far
+  double last_break_t = -kInf;   // time of the last fix after a break
+
   bool have_truth = false;
-  Vec3 last_truth_p = Vec3::Zero();
   double truth_s = 0.0, first_truth_t = 0.0, last_truth_t = 0.0;
 
   // Alignment, fixed at the first evaluated epoch.
@@ -90,7 +122,11 @@ struct Evaluator::State {
   double running_max = 0.0;
 
   State(const earth::LocalFrame& f, const Sources& s, const EvalOptions& o, bool keep)
-      : frame(f), src(s), opt(o), keep_series(keep) {}
+      : frame(f), src(s), opt(o), keep_series(keep), quality(o.truth_quality) {
+    use_course = !s.truth_has_attitude && s.traj_has_heading;
+  }
+
+  Slot& slot(std::uint64_t index) { return slots[static_cast<std::size_t>(index - base)]; }
 
   void drift_add(double dist, double err) {
     const double slack = 1e-9 * std::max(1.0, dist);
@@ -102,11 +138,23 @@ struct Evaluator::State {
     running_max = std::max(running_max, err);
   }
 
-  // Truth record x against the trajectory between samples lo and hi at fraction f.
-  void epoch(const Truth& x, const Sample& lo, const Sample& hi, double f) {
-    Vec3 p = lo.p + (hi.p - lo.p) * f;
-    double heading = kNaN;
-    if (src.traj_has_heading) heading = lo.heading + wrap_pi(hi.heading - lo.heading) * f;
+  // The heading a slot's trajectory heading is compared with (NaN: none).
+  double reference_heading(const Slot& x) const {
+    if (!use_course) return x.heading;
+    if (!std::isfinite(x.course)) return kNaN;
+    // The antenna's course leads the heading by asin(yaw_rate * l_x / V) in a turn (l_x the
+    // antenna's levelled forward offset, V its speed).
+    const double lateral = x.yaw_rate * x.lever_fwd;
+    if (lateral == 0.0) return x.course;
+    if (!(std::abs(lateral) < x.course_speed)) return kNaN;
+    return wrap_pi(x.course - std::asin(lateral / x.course_speed));
+  }
+
+  // A matched, good truth record scored against the trajectory.
+  void epoch(const Slot& x) {
+    Vec3 p = x.traj_p;
+    double heading = x.traj_heading;
+    const double ref = reference_heading(x);
     if (!pivot_set) {
       pivot_set = true;
       s0 = x.s;
@@ -116,8 +164,8 @@ struct Evaluator::State {
         pivot_traj = p;
         pivot_truth = x.p;
         res.align_offset = pivot_truth - pivot_traj;
-        if (std::isfinite(heading) && std::isfinite(x.heading)) {
-          dpsi = wrap_pi(x.heading - heading);
+        if (std::isfinite(heading) && std::isfinite(ref)) {
+          dpsi = wrap_pi(ref - heading);
           res.align_rotated = true;
           res.align_yaw = dpsi;
           R = rot_z(dpsi);
@@ -134,12 +182,11 @@ struct Evaluator::State {
     e.distance = x.s - s0;
     e.err_ned = p - x.p;
     e.err_h = e.err_ned.head<2>().norm();
-    e.heading_err = res.has_heading ? wrap_pi(heading - x.heading) : kNaN;
+    e.heading_err = res.has_heading && std::isfinite(ref) ? wrap_pi(heading - ref) : kNaN;
     e.sigma_h = kNaN;
     e.nees_h = kNaN;
     if (res.has_sigma) {
-      const double sn = lerp(lo.sn, hi.sn, f);
-      const double se = lerp(lo.se, hi.se, f);
+      const double sn = x.sn, se = x.se;
       if (sn > 0.0 && se > 0.0 && std::isfinite(sn) && std::isfinite(se)) {
         const Eigen::Matrix2d P = R2 * Eigen::Vector2d(sn * sn, se * se).asDiagonal() * R2.transpose();
         const Eigen::Vector2d d = e.err_ned.head<2>();
@@ -163,32 +210,103 @@ struct Evaluator::State {
     if (keep_series) res.series.push_back(e);
   }
 
-  // Evaluates the pending truth records that the trajectory now brackets: those before
-  // the latest sample b (bracket a..b), or all of them at the end (final).
+  // Stage 2 of slot x: the trajectory between samples lo and hi at fraction f.
+  void match(Slot& x, const Sample& lo, const Sample& hi, double f) {
+    x.match = Match::kEpoch;
+    x.traj_p = lo.p + (hi.p - lo.p) * f;
+    if (src.traj_has_heading) x.traj_heading = lo.heading + wrap_pi(hi.heading - lo.heading) * f;
+    if (res.has_sigma) {
+      x.sn = lerp(lo.sn, hi.sn, f);
+      x.se = lerp(lo.se, hi.se, f);
+    }
+    x.yaw_rate = hi.yaw_rate;
+    x.lever_fwd = lerp(lo.lever_fwd, hi.lever_fwd, f);
+  }
+
+  // Matches the waiting truth records that the trajectory now brackets: those before the
+  // latest sample b (bracket a..b), or all of them at the end (final).
   void drain(bool final) {
-    while (!pending.empty()) {
-      const Truth& x = pending.front();
+    while (next_match < base + slots.size()) {
+      Slot& x = slot(next_match);
       if (n_traj == 0 || x.t < first_traj_t - kTimeSlack) {
         if (n_traj == 0 && !final) return;
-        ++res.skipped_outside;
+        x.match = Match::kOutside;
       } else if (x.t < b.t) {
         // a.t <= x.t < b.t (or x before the first sample within the slack: its value).
         if (n_traj == 1 || x.t <= a.t) {
-          epoch(x, n_traj == 1 ? b : a, n_traj == 1 ? b : a, 0.0);
+          match(x, n_traj == 1 ? b : a, n_traj == 1 ? b : a, 0.0);
         } else {
           const double span = b.t - a.t;
-          if (span > opt.max_gap) ++res.skipped_gap;
-          else epoch(x, a, b, std::clamp((x.t - a.t) / span, 0.0, 1.0));
+          if (span > opt.max_gap) x.match = Match::kGap;
+          else match(x, a, b, std::clamp((x.t - a.t) / span, 0.0, 1.0));
         }
       } else if (!final) {
         return;  // at or after the latest sample: wait for the next one
       } else if (x.t <= b.t + kTimeSlack) {
-        epoch(x, b, b, 0.0);
+        match(x, b, b, 0.0);
       } else {
-        ++res.skipped_outside;
+        x.match = Match::kOutside;
       }
-      pending.pop_front();
+      ++next_match;
     }
+  }
+
+  // Stage 3: the courses that the fixes seen so far decide (all of them at the end).
+  void courses(bool final) {
+    const double half = 0.5 * opt.course_baseline;
+    while (next_course < base + slots.size()) {
+      Slot& x = slot(next_course);
+      if (!use_course || x.bad) {
+        x.course_done = true;
+        ++next_course;
+        continue;
+      }
+      const bool ahead = !course_fixes.empty() && course_fixes.back().t >= x.t + half - kTimeSlack;
+      if (!ahead && !final && !(last_break_t > x.t)) return;  // wait for later fixes
+      x.course_done = true;
+      ++next_course;
+      // The fixes k (last at or before t - B/2) and j (first at or after t + B/2).
+      auto j = std::lower_bound(course_fixes.begin(), course_fixes.end(), x.t + half - kTimeSlack,
+                                [](const CourseFix& c, double t) { return c.t < t; });
+      auto k = std::upper_bound(course_fixes.begin(), course_fixes.end(), x.t - half + kTimeSlack,
+                                [](double t, const CourseFix& c) { return t < c.t; });
+      if (j == course_fixes.end() || k == course_fixes.begin()) continue;
+      --k;
+      if (j->breaks != k->breaks) continue;  // a gap or a step between them
+      const double dt = j->t - k->t;
+      const Eigen::Vector2d d = (j->p - k->p).head<2>();
+      const double speed = d.norm() / dt;
+      if (!(dt > 0.0) || !(speed >= opt.course_min_speed)) continue;
+      x.course = std::atan2(d.y(), d.x());
+      x.course_speed = speed;
+    }
+  }
+
+  // Scores (or counts) the slots whose stages are done, in order, and trims the course
+  // fixes no slot needs any more.
+  void score() {
+    while (!slots.empty() && slots.front().match != Match::kWaiting && slots.front().course_done) {
+      const Slot& x = slots.front();
+      switch (x.match) {
+        case Match::kOutside: ++res.skipped_outside; break;
+        case Match::kGap: ++res.skipped_gap; break;
+        default:
+          if (x.bad) ++res.skipped_truth_jump;
+          else epoch(x);
+      }
+      slots.pop_front();
+      ++base;
+    }
+    const double keep_from = (slots.empty() ? last_truth_t : slots.front().t) - 0.5 * opt.course_baseline;
+    while (course_fixes.size() >= 2 && course_fixes[1].t <= keep_from - kTimeSlack) course_fixes.pop_front();
+  }
+
+  // The stages as far as the records seen allow: `traj_final` once no trajectory record
+  // follows, `truth_final` once no truth record follows.
+  void advance(bool traj_final, bool truth_final) {
+    drain(traj_final);
+    courses(truth_final);
+    score();
   }
 };
 
@@ -200,43 +318,65 @@ Evaluator::Evaluator(const earth::LocalFrame& frame, const Sources& sources,
                      ", 1e6] m, got " + std::to_string(opt.segment_length));
   if (!(opt.max_gap > 0.0 && opt.max_gap <= 3600.0))
     throw InputError("maximum interpolation gap must be in (0, 3600] s, got " + std::to_string(opt.max_gap));
+  if (!opt.antenna.allFinite() || opt.antenna.norm() > 100.0)
+    throw InputError("the antenna lever arm must be finite and within 100 m of the reference point");
+  if (!std::isfinite(opt.truth_time_offset))
+    throw InputError("the truth time offset must be a finite number of seconds");
+  if (!(opt.course_baseline > 0.0 && opt.course_baseline <= 60.0))
+    throw InputError("the course baseline must be in (0, 60] s, got " + std::to_string(opt.course_baseline));
+  if (!(opt.course_min_speed >= 0.0 && std::isfinite(opt.course_min_speed)))
+    throw InputError("the course's minimum speed must be >= 0 m/s, got " + std::to_string(opt.course_min_speed));
+  if (!opt.antenna.isZero() && !sources.traj_has_heading)
+    throw InputError(quote(sources.traj_file) + ": the antenna lever arm needs the trajectory's heading, "
+                     "which it does not have");
   s_ = std::make_unique<State>(frame, sources, opt, keep_series);
   EvalResult& r = s_->res;
   r.truth_file = sources.truth_file;
   r.traj_file = sources.traj_file;
   r.traj_format = sources.traj_format;
+  r.truth_layout = sources.truth_layout;
   r.segment_length = opt.segment_length;
-  r.has_heading = sources.truth_has_attitude && sources.traj_has_heading;
+  r.has_heading = (sources.truth_has_attitude || s_->use_course) && sources.traj_has_heading;
+  r.heading_source = !sources.traj_has_heading ? "none" : sources.truth_has_attitude ? "truth" : "course";
   r.has_sigma = sources.traj_has_sigma;
+  r.antenna = opt.antenna;
+  r.truth_time_offset = opt.truth_time_offset;
 }
 
 Evaluator::~Evaluator() = default;
 
 void Evaluator::end_trajectory() {
   s_->traj_ended = true;
-  s_->drain(true);
+  s_->advance(true, false);
 }
 
-std::size_t Evaluator::pending() const { return s_->pending.size(); }
+std::size_t Evaluator::pending() const { return s_->slots.size(); }
 
 void Evaluator::add_truth(const TruthRecord& r) {
   State& s = *s_;
-  State::Truth x;
-  x.t = r.t;
+  State::Slot x;
+  x.t = r.t + s.opt.truth_time_offset;
   x.p = s.frame.ned_from_geodetic(r.lla);
   x.heading = s.src.truth_has_attitude ? r.rpy.z() : kNaN;
-  // Path length over every consecutive truth record (horizontal).
-  if (s.have_truth) s.truth_s += (x.p - s.last_truth_p).head<2>().norm();
-  else s.first_truth_t = r.t;
+  const double speed = s.src.truth_has_velocity ? r.v_ned.head<2>().norm() : kNaN;
+  const TruthQualityMonitor::Verdict v = s.quality.add(x.t, x.p, speed);
+  x.bad = v.bad;
+  // Path length over the good records (horizontal; a jump is no distance driven).
+  if (s.have_truth) s.truth_s += v.step;
+  else s.first_truth_t = x.t;
   x.s = s.truth_s;
   s.have_truth = true;
-  s.last_truth_p = x.p;
-  s.last_truth_t = r.t;
+  s.last_truth_t = x.t;
   ++s.res.truth_records;
   if (s.n_traj >= 2 && x.t < s.a.t && x.t >= s.first_traj_t - kTimeSlack)
     throw std::logic_error("Evaluator: a truth record came after the trajectory had passed it");
-  s.pending.push_back(x);
-  s.drain(s.traj_ended);
+  if (v.gap_before || v.stepped) {
+    ++s.breaks;
+    s.last_break_t = x.t;
+  }
+  if (s.use_course && !v.bad && !v.repeated) s.course_fixes.push_back({x.t, x.p, s.breaks});
+  s.slots.push_back(x);
+  s.advance(s.traj_ended, false);
 }
 
 void Evaluator::add_trajectory(const TrajectoryRecord& r) {
@@ -252,14 +392,25 @@ void Evaluator::add_trajectory(const TrajectoryRecord& r) {
   const bool pos_ok = s.src.traj_has_lla
                           ? std::isfinite(r.lla.lat) && std::isfinite(r.lla.lon) && std::isfinite(r.lla.h)
                           : r.p_inN.allFinite();
-  if (!pos_ok || (s.src.traj_has_heading && !std::isfinite(r.rpy.z())))
+  const bool lever = !s.opt.antenna.isZero();
+  const bool att_ok = !(s.src.traj_has_heading || lever) || std::isfinite(r.rpy.z());
+  const bool rp_ok = !(lever && s.src.traj_has_roll_pitch) || (std::isfinite(r.rpy.x()) && std::isfinite(r.rpy.y()));
+  if (!pos_ok || !att_ok || !rp_ok)
     throw InputError(quote(s.res.traj_file) + ": record " + std::to_string(s.n_traj) +
                      " (0-based, t=" + std::to_string(r.t) + "): " +
-                     (pos_ok ? "heading" : "position") + " is not finite");
+                     (!pos_ok ? "position" : !att_ok ? "heading" : "roll/pitch") + " is not finite");
   State::Sample k;
   k.t = r.t;
   k.p = s.src.traj_has_lla ? s.frame.ned_from_geodetic(r.lla) : r.p_inN;
-  if (s.src.traj_has_heading) k.heading = r.rpy.z();
+  if (lever) {
+    const Vec3 rpy = s.src.traj_has_roll_pitch ? r.rpy : Vec3(0.0, 0.0, r.rpy.z());
+    k.p += dcm_from_euler(rpy) * s.opt.antenna;
+    k.lever_fwd = (dcm_from_euler(Vec3(rpy.x(), rpy.y(), 0.0)) * s.opt.antenna).x();
+  }
+  if (s.src.traj_has_heading) {
+    k.heading = r.rpy.z();
+    if (s.n_traj > 0) k.yaw_rate = wrap_pi(k.heading - s.b.heading) / (k.t - s.b.t);
+  }
   if (s.src.traj_has_sigma) {
     k.sn = r.p_std.x();
     k.se = r.p_std.y();
@@ -269,13 +420,14 @@ void Evaluator::add_trajectory(const TrajectoryRecord& r) {
   s.b = k;
   ++s.n_traj;
   ++s.res.traj_records;
-  s.drain(false);
+  s.advance(false, false);
 }
 
 EvalResult Evaluator::finish() {
   State& s = *s_;
-  s.drain(true);
+  s.advance(true, true);
   EvalResult& res = s.res;
+  res.truth_quality = s.quality.report();
   if (res.truth_records == 0) throw InputError(quote(res.truth_file) + ": no truth records");
   if (s.n_traj == 0) throw InputError(quote(res.traj_file) + ": no trajectory records");
   if (res.epochs == 0)
@@ -285,11 +437,13 @@ EvalResult Evaluator::finish() {
                      std::to_string(s.first_truth_t) + " .. " + std::to_string(s.last_truth_t) +
                      " s" +
                      (res.skipped_gap ? ", or only inside gaps longer than the maximum gap" : "") +
+                     (res.skipped_truth_jump ? ", or only at jumps of the truth" : "") +
                      "); do both use the same time scale (GPS seconds of week)?");
   res.t_end = s.last.t;
   res.duration = res.t_end - res.t_start;
   res.distance = s.last.distance;
   res.final_error = s.last.err_h;
+  res.final_error_ratio = res.distance > 0.0 ? res.final_error / res.distance : kNaN;
   res.rms_error = std::sqrt(s.sum_e2 / static_cast<double>(res.epochs));
   // The segments completed by the total distance (same slack as drift_rate_curve()).
   const double slack = 1e-9 * std::max(1.0, res.distance);
@@ -305,6 +459,7 @@ EvalResult Evaluator::finish() {
     for (double r : res.drift_curve) sum += r;
     res.drift_rate = sum / static_cast<double>(res.drift_curve.size());
   }
+  res.heading_epochs = s.heading_count;
   if (s.heading_count > 0) {
     res.heading_rmse = std::sqrt(s.sum_h2 / static_cast<double>(s.heading_count));
     res.heading_max_abs = s.max_h;
@@ -328,9 +483,12 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
   src.truth_file = truth.file.string();
   src.traj_file = traj.file.string();
   src.traj_format = trajectory_format_name(traj.format);
-  src.truth_has_attitude = truth.has_velocity_attitude;
+  src.truth_layout = truth_layout_name(truth.layout);
+  src.truth_has_attitude = truth.has_attitude;
+  src.truth_has_velocity = truth.has_velocity;
   src.traj_has_lla = traj.has_lla;
   src.traj_has_heading = traj.has_heading;
+  src.traj_has_roll_pitch = traj.has_roll_pitch;
   src.traj_has_sigma = traj.has_pos_std;
   Evaluator ev(frame, src, opt, true);
   if (truth.records.empty()) throw InputError(quote(truth.file) + ": no truth records");
@@ -338,7 +496,8 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
   // In step: the truth records before each trajectory record go in first.
   std::size_t i = 0;
   for (const TrajectoryRecord& r : traj.records) {
-    while (i < truth.records.size() && truth.records[i].t < r.t) ev.add_truth(truth.records[i++]);
+    while (i < truth.records.size() && truth.records[i].t + opt.truth_time_offset < r.t)
+      ev.add_truth(truth.records[i++]);
     ev.add_trajectory(r);
   }
   ev.end_trajectory();
@@ -356,6 +515,15 @@ void json_number(std::string& o, double v) {
     return;
   }
   append_double(o, v, 10);
+}
+
+void json_vec3(std::string& o, const Vec3& v) {
+  o += '[';
+  for (int k = 0; k < 3; ++k) {
+    if (k) o += ", ";
+    json_number(o, v[k]);
+  }
+  o += ']';
 }
 
 class JsonObject {
@@ -409,17 +577,20 @@ std::string to_json(const EvalResult& r) {
   j.str("truth_file", r.truth_file);
   j.str("traj_file", r.traj_file);
   j.str("traj_format", r.traj_format);
+  j.str("truth_layout", r.truth_layout);
   j.count("truth_records", r.truth_records);
   j.count("traj_records", r.traj_records);
   j.count("epochs", r.epochs);
   j.count("skipped_outside", r.skipped_outside);
   j.count("skipped_gap", r.skipped_gap);
+  j.count("skipped_truth_jump", r.skipped_truth_jump);
   j.num("t_start_s", r.t_start);
   j.num("t_end_s", r.t_end);
   j.num("duration_s", r.duration);
   j.num("distance_m", r.distance);
   j.num("segment_m", r.segment_length);
   j.num("drift_rate_pct", r.drift_rate * 100.0);
+  j.num("final_error_over_distance_pct", r.final_error_ratio * 100.0);
   j.key("drift_curve_pct");
   o += '[';
   for (std::size_t k = 0; k < r.drift_curve.size(); ++k) {
@@ -427,6 +598,8 @@ std::string to_json(const EvalResult& r) {
     json_number(o, r.drift_curve[k] * 100.0);
   }
   o += ']';
+  j.str("heading_source", r.heading_source);
+  j.count("heading_epochs", r.heading_epochs);
   j.num("heading_rmse_deg", r.heading_rmse / kDeg);
   j.num("heading_max_abs_deg", r.heading_max_abs / kDeg);
   j.num("max_error_m", r.max_error);
@@ -440,12 +613,39 @@ std::string to_json(const EvalResult& r) {
   j.boolean("align_rotated", r.align_rotated);
   j.num("align_yaw_deg", r.align_yaw / kDeg);
   j.key("align_offset_ned_m");
-  o += '[';
-  for (int k = 0; k < 3; ++k) {
-    if (k) o += ", ";
-    json_number(o, r.align_offset[k]);
+  json_vec3(o, r.align_offset);
+  j.key("antenna_m");
+  json_vec3(o, r.antenna);
+  j.num("truth_time_offset_s", r.truth_time_offset);
+  const TruthQualityReport& q = r.truth_quality;
+  j.key("truth_quality");
+  o += "{\"records\": " + std::to_string(q.records) + ", \"median_interval_s\": ";
+  json_number(o, q.median_interval);
+  o += ", \"gap_count\": " + std::to_string(q.gap_count) + ", \"stall_count\": " +
+       std::to_string(q.stall_count) + ", \"gap_s\": ";
+  json_number(o, q.gap_seconds);
+  o += ", \"gap_distance_m\": ";
+  json_number(o, q.gap_distance);
+  o += ", \"jump_count\": " + std::to_string(q.jump_count) + ", \"bad_records\": " +
+       std::to_string(q.bad_records) + ", \"repeated\": " + std::to_string(q.repeated) + ",\n    \"gaps\": [";
+  for (std::size_t k = 0; k < q.gaps.size(); ++k) {
+    o += k ? ", {\"t_from_s\": " : "{\"t_from_s\": ";
+    json_number(o, q.gaps[k].t_from);
+    o += ", \"t_to_s\": ";
+    json_number(o, q.gaps[k].t_to);
+    o += ", \"repeated\": " + std::to_string(q.gaps[k].repeated) + "}";
   }
-  o += ']';
+  o += "],\n    \"jumps\": [";
+  for (std::size_t k = 0; k < q.jumps.size(); ++k) {
+    o += k ? ", {\"t_s\": " : "{\"t_s\": ";
+    json_number(o, q.jumps[k].t);
+    o += ", \"record\": " + std::to_string(q.jumps[k].record) + ", \"speed_m_s\": ";
+    json_number(o, q.jumps[k].speed);
+    o += ", \"accel_m_s2\": ";
+    json_number(o, q.jumps[k].accel);
+    o += "}";
+  }
+  o += "]}";
   j.close();
   return o;
 }

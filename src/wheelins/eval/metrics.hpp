@@ -18,9 +18,21 @@
 //  * Drift rate (paper VI-B): with l the segment length and K = floor(s_total / l),
 //    for k = 1..K:  r_k = max{ e_h(t) : s(t) <= k l } / (k l);
 //    the drift rate is mean(r_1..r_K). Undefined (NaN) when s_total < l.
-//  * Heading error: wrap(heading_traj - heading_truth) into (-180, 180] deg;
-//    RMSE over the evaluated epochs. Needs truth attitude (not in 5-column truth)
-//    and a trajectory heading.
+//  * Heading error: wrap(heading_traj - heading_ref) into (-180, 180] deg; RMSE over the
+//    evaluated epochs that have both. Needs a trajectory heading. heading_ref is
+//      - the truth's heading where the truth has attitude (11-column, TUM): source "truth";
+//      - otherwise (5-column, text) the truth's course, the direction of its horizontal
+//        motion: source "course". At a truth epoch t_i it is the direction from the last
+//        good fix at or before t_i - B/2 to the first good fix at or after t_i + B/2
+//        (B = course_baseline, 1 s; a chord centred on t_i is parallel to the tangent of a
+//        circular arc), taken only where the speed along that chord is at least
+//        course_min_speed (1 m/s) and no truth gap or step lies between the two fixes. It is
+//        the vehicle's heading only while the vehicle drives forward without side slip (a
+//        car reversing reads 180 deg off). With an antenna lever arm l the antenna's course
+//        leads the heading in turns by asin(yaw_rate * l_x / V) (l_x the lever arm's forward
+//        component with the trajectory's roll and pitch taken off, V the antenna's speed
+//        along the chord, yaw_rate the trajectory's); that is taken off.
+//    heading_rmse and heading_max_abs are over the epochs with a heading_ref.
 //  * 1-sigma consistency (when the trajectory carries north/east std):
 //    P = diag(sigma_n^2, sigma_e^2) (rotated with the trajectory when aligned),
 //    sigma_h = sqrt(trace P) = sqrt(sigma_n^2 + sigma_e^2), the RMS of e_h that P
@@ -29,6 +41,18 @@
 //    e_h^2) and 1 - exp(-4.5) = 0.989 for sigma_n = sigma_e.
 //    Horizontal NEES = [dn de] P^-1 [dn de]^T, mean over epochs (2 if consistent).
 //    Epochs with sigma_n or sigma_e not positive and finite are left out of both.
+//  * Final error over distance: final_error / distance (fraction; shown in %), next to the
+//    drift rate: the end-point figure many papers quote.
+//  * Antenna: with `antenna` l (vehicle frame: x forward, y right, z down, from the
+//    trajectory's reference point) the trajectory is moved to the antenna before anything
+//    else: p_ant = p + C_v^n(roll, pitch, heading) l, with the trajectory's attitude (roll
+//    and pitch 0 where it has none; a lever arm without a trajectory heading is an error).
+//  * Truth time offset: truth_time_offset [s] is added to every truth time.
+//  * Truth quality (truth_quality.hpp): the truth records are checked as they come; a
+//    jumped fix (and its repeats) is left out of every figure and counted
+//    (skipped_truth_jump); gaps, stalls and jumps are listed in truth_quality. A truth gap
+//    holds no truth epochs, so nothing is scored inside it; the course is not taken across
+//    it and the distance counts the straight line across it (truth_quality.gap_distance).
 //  * Alignment (optional, for results in another tool's frame): the trajectory is
 //    rotated about the vertical through its position at the first evaluated epoch
 //    by dpsi = wrap(heading_truth - heading_traj) there, and shifted so that
@@ -41,6 +65,7 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/eval/truth_quality.hpp"
 #include "wheelins/io/trajectory.hpp"
 #include "wheelins/io/truth.hpp"
 
@@ -53,6 +78,13 @@ struct EvalOptions {
   double segment_length = 100.0;  ///< l [m] of the drift rate
   bool align = false;             ///< shift + rotate the trajectory onto the truth at the start
   double max_gap = 5.0;           ///< [s] largest trajectory gap interpolated across
+  /// The antenna (the truth's point) in the vehicle frame from the trajectory's reference
+  /// point [m]: x forward, y right, z down.
+  Vec3 antenna = Vec3::Zero();
+  double truth_time_offset = 0.0;  ///< [s] added to every truth time
+  double course_baseline = 1.0;    ///< B [s] of the course heading, in (0, 60]
+  double course_min_speed = 1.0;   ///< [m/s] slowest truth motion whose course is used
+  TruthQualityOptions truth_quality{};  ///< the thresholds of the truth quality checks
 };
 
 /// The comparison at one evaluated truth epoch.
@@ -68,19 +100,28 @@ struct EpochError {
 
 struct EvalResult {
   std::string truth_file, traj_file, traj_format;
+  std::string truth_layout;           ///< Sources::truth_layout (empty when not given)
   std::size_t truth_records = 0, traj_records = 0;
   std::size_t epochs = 0;             ///< evaluated truth epochs
   std::size_t skipped_outside = 0;    ///< truth epochs outside the trajectory's time span
   std::size_t skipped_gap = 0;        ///< truth epochs inside a trajectory gap > max_gap
+  std::size_t skipped_truth_jump = 0; ///< truth epochs left out: a jumped fix or its repeat
   double t_start = 0.0, t_end = 0.0, duration = 0.0;  ///< evaluated span [s]
   double distance = 0.0;              ///< s_total [m]
   double segment_length = 100.0;
   std::vector<double> drift_curve;    ///< r_k, k = 1..K (fractions, not %)
   double drift_rate = 0.0;            ///< mean r_k (fraction); NaN if K = 0
   bool has_heading = false;
+  /// Where heading_ref comes from: "truth" (its attitude), "course" (its motion) or "none".
+  std::string heading_source = "none";
+  std::size_t heading_epochs = 0;     ///< epochs with a heading error
   double heading_rmse = 0.0;          ///< [rad]; NaN without headings
   double heading_max_abs = 0.0;       ///< [rad]; NaN without headings
   double max_error = 0.0, final_error = 0.0, rms_error = 0.0;  ///< horizontal [m]
+  double final_error_ratio = 0.0;     ///< final_error / distance (fraction); NaN at distance 0
+  Vec3 antenna = Vec3::Zero();        ///< EvalOptions::antenna [m]
+  double truth_time_offset = 0.0;     ///< EvalOptions::truth_time_offset [s]
+  TruthQualityReport truth_quality;   ///< over every truth record fed
   bool has_sigma = false;
   std::size_t sigma_epochs = 0;       ///< epochs with usable north/east sigma
   double within_3sigma = 0.0;         ///< fraction in [0, 1]; NaN without sigma
@@ -115,25 +156,32 @@ class Evaluator {
  public:
   struct Sources {
     std::string truth_file, traj_file, traj_format;
-    bool truth_has_attitude = true;  ///< truth headings available
+    std::string truth_layout;        ///< for the result (truth_layout_name()); may be empty
+    bool truth_has_attitude = true;  ///< truth headings available (else the course is used)
+    bool truth_has_velocity = true;  ///< truth velocities available (standing still is known)
     bool traj_has_lla = true;        ///< trajectory positions from lla (else p_inN)
     bool traj_has_heading = true;
+    bool traj_has_roll_pitch = true; ///< roll and pitch for the antenna lever arm
     bool traj_has_sigma = true;      ///< north/east 1-sigma in p_std
   };
-  /// Throws InputError for options out of range.
+  /// Throws InputError for options out of range, and for an antenna lever arm without a
+  /// trajectory heading.
   Evaluator(const earth::LocalFrame& frame, const Sources& sources, const EvalOptions& options,
             bool keep_series);
   ~Evaluator();
   Evaluator(const Evaluator&) = delete;
   Evaluator& operator=(const Evaluator&) = delete;
 
+  /// The next truth record, as read (EvalOptions::truth_time_offset is added here: a
+  /// feeder compares r.t + truth_time_offset with the trajectory's times).
   void add_truth(const TruthRecord& r);
   void add_trajectory(const TrajectoryRecord& r);
   /// No trajectory records follow: the truth records still to come are evaluated (or
   /// counted as outside) as they arrive instead of waiting, so feeding the rest of a long
   /// truth file keeps memory flat.
   void end_trajectory();
-  /// Truth records waiting for the trajectory to reach them.
+  /// Truth records held: waiting for the trajectory to reach them, or for the truth fixes
+  /// after them (course_baseline / 2 later) where the heading comes from the course.
   std::size_t pending() const;
   /// The result; InputError (naming the files) when no truth epoch fell inside the
   /// trajectory.
@@ -146,9 +194,10 @@ class Evaluator {
 
 /// Compares `traj` with `truth` in `frame` (the local NED frame both are expressed
 /// in). Trajectory records with lat/lon/h are mapped into `frame`; records with
-/// only north/east/down are taken as already in `frame`. Throws InputError (naming
-/// the files) when no truth epoch falls inside the trajectory, or for options out
-/// of range.
+/// only north/east/down are taken as already in `frame`. The truth's heading is used
+/// where it has attitude (TruthData::has_attitude), its course otherwise. Throws
+/// InputError (naming the files) when no truth epoch falls inside the trajectory, or for
+/// options out of range.
 EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
                     const earth::LocalFrame& frame, const EvalOptions& options = {});
 

@@ -8,21 +8,25 @@
 
 namespace wheelins::eval {
 
-RunEvaluation::RunEvaluation(const std::filesystem::path& truth_file, const earth::Geodetic& origin)
-    : truth_(std::make_unique<TruthReader>(truth_file)) {
+RunEvaluation::RunEvaluation(const std::filesystem::path& truth_file, const earth::Geodetic& origin,
+                             const RunEvaluationOptions& options)
+    : truth_(std::make_unique<TruthReader>(truth_file, options.layout, options.truth)),
+      truth_time_offset_(options.eval.truth_time_offset) {
   Evaluator::Sources src;
   src.truth_file = truth_->file().string();
   src.traj_file = "the run's vehicle solution";
   src.traj_format = "memory";
-  src.truth_has_attitude = truth_->has_velocity_attitude();
-  evaluator_ = std::make_unique<Evaluator>(earth::LocalFrame(origin), src, EvalOptions{}, false);
+  src.truth_layout = truth_layout_name(truth_->layout());
+  src.truth_has_attitude = truth_->has_attitude();
+  src.truth_has_velocity = truth_->has_velocity();
+  evaluator_ = std::make_unique<Evaluator>(earth::LocalFrame(origin), src, options.eval, false);
   have_next_truth_ = truth_->next(next_truth_);
 }
 
 RunEvaluation::~RunEvaluation() = default;
 
 void RunEvaluation::feed_truth_before(double t) {
-  while (have_next_truth_ && next_truth_.t < t) {
+  while (have_next_truth_ && next_truth_.t + truth_time_offset_ < t) {
     evaluator_->add_truth(next_truth_);
     have_next_truth_ = truth_->next(next_truth_);
   }

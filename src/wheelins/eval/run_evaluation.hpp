@@ -4,6 +4,11 @@
 // cannot be opened, or whose first record is bad, throws from the constructor
 // (before the run); a bad record met later is held and thrown by finish(), so the
 // caller can write the trajectory first.
+//
+// Every truth layout streams (truth.hpp's TruthReader reads text and TUM line by line):
+// the memory held is the truth records within the course baseline (1 s, where the truth
+// has no heading) plus those between two evaluated vehicle records, kMedianWindow intervals
+// of the quality checks and the listed gaps and jumps -- not the file.
 #pragma once
 
 #include <filesystem>
@@ -15,11 +20,19 @@
 
 namespace wheelins::eval {
 
+/// How the truth is read and compared (the defaults are what `wheelins run` always did).
+struct RunEvaluationOptions {
+  TruthLayout layout = TruthLayout::kAuto;
+  TruthReadOptions truth{};  ///< time scale and offset on read, text columns, TUM frame and origin
+  EvalOptions eval{};      ///< antenna lever arm, truth time offset, segment length, ...
+};
+
 class RunEvaluation {
  public:
   static constexpr double kInterval = 0.05;  ///< [s] between the records evaluated (20 Hz)
 
-  RunEvaluation(const std::filesystem::path& truth_file, const earth::Geodetic& origin);
+  RunEvaluation(const std::filesystem::path& truth_file, const earth::Geodetic& origin,
+                const RunEvaluationOptions& options = {});
   ~RunEvaluation();
   RunEvaluation(const RunEvaluation&) = delete;
   RunEvaluation& operator=(const RunEvaluation&) = delete;
@@ -34,6 +47,7 @@ class RunEvaluation {
   void feed_truth_before(double t);
   std::unique_ptr<TruthReader> truth_;
   std::unique_ptr<Evaluator> evaluator_;
+  double truth_time_offset_ = 0.0;
   TruthRecord next_truth_;
   bool have_next_truth_ = false;
   double next_keep_ = -1e300;

@@ -358,6 +358,9 @@ ManifestDraft draft_manifest(const fs::path& dir_in, const fs::path& manifest_fi
   std::optional<TruthStart> ts;
   if (!truth.empty()) {
     const TruthLayout layout = detect_truth_layout(truth);
+    if (layout != TruthLayout::kGins11 && layout != TruthLayout::kPos5)
+      throw InputError(quote(truth) + ": a text truth file (" + truth_layout_name(layout) +
+                       "); the manifest draft reads the binary GINS.bin layouts");
     m.truth_file = rel(truth, mdir);
     ts = truth_start(truth, layout, start);
     const std::string tname = truth.filename().string();

@@ -1,5 +1,5 @@
-// Truth files (truth.hpp): the layout detection (11- or 5-column rows, checked against
-// the content), the streaming reader, read_truth() and the writers.
+// Truth files (truth.hpp): the layout detection (text, or 11- or 5-column rows checked
+// against the content), the streaming reader of every layout, read_truth() and the writers.
 #include "wheelins/io/truth.hpp"
 
 #include <algorithm>
@@ -10,6 +10,7 @@
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/binary.hpp"
 #include "wheelins/io/text_util.hpp"
+#include "wheelins/io/truth_text.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins {
@@ -70,7 +71,9 @@ TruthLayout truth_layout_from_name(const std::string& name) {
   if (name == "auto") return TruthLayout::kAuto;
   if (name == "gins11" || name == "11") return TruthLayout::kGins11;
   if (name == "pos5" || name == "5") return TruthLayout::kPos5;
-  throw InputError("unknown truth layout '" + name + "' (expected auto, gins11 or pos5)");
+  if (name == "text" || name == "csv") return TruthLayout::kText;
+  if (name == "tum") return TruthLayout::kTum;
+  throw InputError("unknown truth layout '" + name + "' (expected auto, gins11, pos5, text or tum)");
 }
 
 const char* truth_layout_name(TruthLayout layout) {
@@ -78,6 +81,8 @@ const char* truth_layout_name(TruthLayout layout) {
     case TruthLayout::kAuto: return "auto";
     case TruthLayout::kGins11: return "gins11";
     case TruthLayout::kPos5: return "pos5";
+    case TruthLayout::kText: return "text";
+    case TruthLayout::kTum: return "tum";
   }
   return "?";
 }
@@ -85,6 +90,7 @@ const char* truth_layout_name(TruthLayout layout) {
 TruthLayout detect_truth_layout(const std::filesystem::path& file) {
   const std::uint64_t bytes = io_detail::check_input_file(file, "a truth file (GINS.bin)");
   if (bytes == 0) throw InputError(quote(file) + ": empty truth file");
+  if (looks_like_text_file(file)) return detect_text_truth_layout(file);
   const bool fits11 = bytes % (8 * kCols11) == 0;
   const bool fits5 = bytes % (8 * kCols5) == 0;
   if (!fits11 && !fits5)
@@ -116,17 +122,50 @@ TruthLayout detect_truth_layout(const std::filesystem::path& file) {
                    "increasing time, lat/lon); give the layout explicitly (gins11 or pos5)");
 }
 
-TruthReader::TruthReader(const std::filesystem::path& file, TruthLayout layout)
-    : file_(file), layout_(layout == TruthLayout::kAuto ? detect_truth_layout(file) : layout) {
+TruthReader::TruthReader(const std::filesystem::path& file, TruthLayout layout,
+                         const TruthReadOptions& options)
+    : file_(file), layout_(layout == TruthLayout::kAuto ? detect_truth_layout(file) : layout),
+      options_(options) {
+  if (!(std::isfinite(options.time_scale) && options.time_scale > 0.0))
+    throw InputError(quote(file) + ": time scale " + num(options.time_scale) + " must be a positive number");
+  if (!std::isfinite(options.time_offset))
+    throw InputError(quote(file) + ": time offset " + num(options.time_offset) + " must be finite");
+  if (layout_ == TruthLayout::kText || layout_ == TruthLayout::kTum) {
+    text_ = std::make_unique<TextTruthReader>(file, layout_, options);
+    return;
+  }
   rows_ = std::make_unique<BinaryRowReader>(file, layout_ == TruthLayout::kGins11 ? kCols11 : kCols5);
   if (rows_->rows() == 0) throw InputError(quote(file) + ": empty truth file");
 }
 
 TruthReader::~TruthReader() = default;
 
-std::uint64_t TruthReader::rows() const { return rows_->rows(); }
+std::uint64_t TruthReader::rows() const { return text_ ? text_->rows() : rows_->rows(); }
+
+std::uint64_t TruthReader::collapsed() const { return text_ ? text_->collapsed() : 0; }
+
+std::string TruthReader::describe() const {
+  std::string s = truth_layout_name(layout_);
+  if (text_) return s + ": " + text_->describe();
+  s += layout_ == TruthLayout::kGins11 ? ": position, velocity, attitude" : ": position only";
+  if (options_.time_scale != 1.0) s += "; time x " + num(options_.time_scale);
+  if (options_.time_offset != 0.0)
+    s += std::string("; time ") + (options_.time_offset > 0.0 ? "+ " : "- ") + num(std::abs(options_.time_offset)) + " s";
+  return s;
+}
 
 bool TruthReader::next(TruthRecord& rec) {
+  if (text_) return text_->next(rec);
+  if (!next_binary(rec)) return false;
+  if (options_.time_scale != 1.0 || options_.time_offset != 0.0) {
+    rec.t = options_.time_scale * rec.t + options_.time_offset;
+    if (!std::isfinite(rec.t))
+      throw InputError(where(file_, rows_->index()) + "time is not finite after scaling");
+  }
+  return true;
+}
+
+bool TruthReader::next_binary(TruthRecord& rec) {
   const double* r = rows_->next();
   if (!r) return false;
   const std::uint64_t i = rows_->index();
@@ -176,31 +215,61 @@ bool TruthReader::next(TruthRecord& rec) {
   return true;
 }
 
-TruthData read_truth(const std::filesystem::path& file, TruthLayout layout) {
-  TruthReader rd(file, layout);
+TruthData read_truth(const std::filesystem::path& file, TruthLayout layout,
+                     const TruthReadOptions& options) {
+  TruthReader rd(file, layout, options);
   TruthData out;
   out.file = file;
   out.layout = rd.layout();
-  out.has_velocity_attitude = rd.has_velocity_attitude();
-  out.records.reserve(rd.rows());
+  out.has_velocity = rd.has_velocity();
+  out.has_attitude = rd.has_attitude();
+  if (rd.layout() == TruthLayout::kGins11 || rd.layout() == TruthLayout::kPos5) out.records.reserve(rd.rows());
   TruthRecord rec;
   while (rd.next(rec)) out.records.push_back(rec);
   out.gps_week = rd.gps_week();
+  out.rows = rd.rows();
+  out.collapsed = rd.collapsed();
+  out.description = rd.describe();
+  if (out.collapsed > 0)
+    out.description += "; " + std::to_string(out.rows) + " rows, " + std::to_string(out.collapsed) +
+                       " repeating the fix before them, " + std::to_string(out.records.size()) + " fixes";
   return out;
 }
 
 TruthWriter::TruthWriter(const std::filesystem::path& file, bool overwrite, double gps_week)
-    : file_(file), overwrite_(overwrite), gps_week_(gps_week) {
+    : TruthWriter(file, TruthLayout::kGins11, overwrite, gps_week) {}
+
+TruthWriter::TruthWriter(const std::filesystem::path& file, TruthLayout layout, bool overwrite,
+                         double gps_week)
+    : file_(file), layout_(layout), overwrite_(overwrite), gps_week_(gps_week) {
+  if (layout != TruthLayout::kGins11 && layout != TruthLayout::kPos5)
+    throw InputError(quote(file) + ": truth files are written as gins11 or pos5, not " +
+                     truth_layout_name(layout));
   if (!std::isfinite(gps_week) || gps_week < 0.0 || gps_week != std::floor(gps_week))
     throw InputError(quote(file) + ": GPS week " + num(gps_week) +
                      " is not a non-negative integer");
   check_output_target(file, overwrite);
-  out_ = std::make_unique<BinaryRowWriter>(file, kCols11);
+  out_ = std::make_unique<BinaryRowWriter>(file, layout == TruthLayout::kGins11 ? kCols11 : kCols5);
 }
 
 TruthWriter::~TruthWriter() = default;
 
 void TruthWriter::write(const TruthRecord& rec) {
+  if (layout_ == TruthLayout::kPos5) {
+    const double row[kCols5] = {rec.t, rec.lla.lat / kDeg, rec.lla.lon / kDeg, rec.lla.h, 0.0};
+    for (double v : row)
+      if (!std::isfinite(v))
+        throw InputError(where(file_, rows_) + "cannot write a non-finite truth value");
+    if (!lat_lon_ok(row[1], row[2]))
+      throw InputError(where(file_, rows_) + "latitude/longitude out of range");
+    if (rows_ > 0 && !(rec.t > last_t_))
+      throw InputError(where(file_, rows_) + "time " + num(rec.t) +
+                       " s does not increase (previous record: " + num(last_t_) + " s)");
+    out_->write(row);
+    last_t_ = rec.t;
+    ++rows_;
+    return;
+  }
   const double row[kCols11] = {gps_week_,
                                rec.t,
                                rec.lla.lat / kDeg,
@@ -234,6 +303,13 @@ void TruthWriter::commit() {
 void write_truth(const std::filesystem::path& file, const std::vector<TruthRecord>& records,
                  bool overwrite, double gps_week) {
   TruthWriter w(file, overwrite, gps_week);
+  for (const auto& r : records) w.write(r);
+  w.commit();
+}
+
+void write_truth(const std::filesystem::path& file, const std::vector<TruthRecord>& records,
+                 TruthLayout layout, bool overwrite) {
+  TruthWriter w(file, layout, overwrite);
   for (const auto& r : records) w.write(r);
   w.commit();
 }

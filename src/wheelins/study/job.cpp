@@ -204,7 +204,9 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     src.truth_file = truth.file().string();
     src.traj_file = "the vehicle solution of " + who;
     src.traj_format = "memory";
-    src.truth_has_attitude = truth.has_velocity_attitude();
+    src.truth_layout = truth_layout_name(truth.layout());
+    src.truth_has_attitude = truth.has_attitude();
+    src.truth_has_velocity = truth.has_velocity();
     eval::Evaluator ev(earth::LocalFrame(req.manifest.origin), src, eval::EvalOptions{},
                        j.keep_series);
     TruthRecord next;
