@@ -23,6 +23,7 @@ struct Options {
   double segment = 100.0;
   double max_gap = 5.0;
   bool align = false;
+  double align_start = 0.0;
   bool force = false;
   std::string json, series, origin;
   std::string antenna, truth_columns, truth_frame = "enu", truth_origin;
@@ -131,7 +132,11 @@ void print_table(std::ostream& os, const eval::EvalResult& r, const TruthData& t
     row("within 3 sigma (horiz.)", "n/a (no north/east std in the trajectory)");
   if (const std::string w = eval::sigma_warning(r); !w.empty())
     std::fprintf(stderr, "warning: %s\n", w.c_str());
-  if (r.aligned)
+  if (r.aligned && r.align_start > 0.0)
+    row("alignment", "start aligned over the truth's first " + fmt(r.align_start, 0, " m") + ": rotation " +
+                         fmt(r.align_yaw / kDeg, 3, " deg") + ", shift n/e " + fmt(r.align_offset.x(), 3) + " / " +
+                         fmt(r.align_offset.y(), 3) + " m (fit residual " + fmt(r.align_residual, 3, " m") + ")");
+  else if (r.aligned)
     row("alignment", "shift n/e/d " + fmt(r.align_offset.x(), 3) + " / " +
                          fmt(r.align_offset.y(), 3) + " / " + fmt(r.align_offset.z(), 3) +
                          " m, " +
@@ -199,6 +204,11 @@ const bool registered = cli::register_command(
       sub.add_flag("--align", o->align,
                    "Shift and rotate the trajectory so its first epoch matches the truth "
                    "(for results in another tool's frame)");
+      sub.add_option("--align-start", o->align_start,
+                     "Rotate and shift the trajectory so its first METRES of travel lie on the truth's (a run "
+                     "without an initial heading, in a local frame; the heading taken from the reference at the "
+                     "start, as the paper does); 0: off")
+          ->capture_default_str();
       sub.add_option("--json", o->json, "Write the metrics as JSON to FILE ('-' for stdout)");
       sub.add_option("--series", o->series, "Write per-epoch errors as CSV to FILE");
       sub.add_option("--origin", o->origin,
@@ -231,6 +241,7 @@ const bool registered = cli::register_command(
         opt.segment_length = o->segment;
         opt.max_gap = o->max_gap;
         opt.align = o->align;
+        opt.align_start = o->align_start;
         opt.truth_time_offset = o->truth_time_offset;
         if (!o->antenna.empty()) {
           const std::vector<double> l = parse_three("--antenna", o->antenna, "x,y,z in metres");

@@ -45,8 +45,11 @@ struct RunArgs {
   bool no_data_checks = false;
   bool force = false;
   bool quiet = false;
-  std::optional<double> duration, output_interval, covariance_interval;
+  std::optional<double> duration, output_interval, covariance_interval, align_start;
 };
+
+/// [m] of the truth's travel a run without an initial heading is aligned on for scoring.
+constexpr double kDefaultAlignStart = 100.0;
 
 /// A command-line number in its range [lo, hi] (NaN, infinities and 1e400 fail too).
 void check_range(const std::optional<double>& v, const char* option, double lo, double hi,
@@ -116,8 +119,14 @@ int run(const RunArgs& a) {
   const bool evaluate = req.manifest.truth_file && !a.no_evaluate;
   std::unique_ptr<eval::RunEvaluation> evaluation;
   if (evaluate) {
+    eval::RunEvaluationOptions eo;
+    eo.eval.truth_time_offset = req.manifest.truth_time_offset;
+    if (req.manifest.antenna_inV) eo.eval.antenna = *req.manifest.antenna_inV;
+    // A run without an initial heading is in a local frame: its start is aligned onto the
+    // truth's (the heading from the reference at the start, as the paper takes it).
+    eo.eval.align_start = a.align_start ? *a.align_start : (req.manifest.heading_known ? 0.0 : kDefaultAlignStart);
     evaluation = std::make_unique<eval::RunEvaluation>(req.manifest.resolve(*req.manifest.truth_file),
-                                                       req.manifest.origin);
+                                                       req.manifest.origin, eo);
     req.on_record = [&](const TrajectoryRecord& r) { evaluation->add(r); };
   }
 
@@ -171,8 +180,14 @@ int run(const RunArgs& a) {
     else
       std::printf("  drift rate          %10.3f %% of distance (l = %.0f m)\n", 100.0 * e.drift_rate,
                   e.segment_length);
-    if (e.has_heading) std::printf("  heading RMSE        %10.3f deg\n", e.heading_rmse / kDeg);
+    std::printf("  final error         %10.3f %% of distance (%.2f m)\n", 100.0 * e.final_error_ratio, e.final_error);
+    if (e.has_heading)
+      std::printf("  heading RMSE        %10.3f deg%s\n", e.heading_rmse / kDeg,
+                  e.heading_source == "course" ? " (against the truth's course where it moves)" : "");
     std::printf("  max / final error   %6.2f / %.2f m\n", e.max_error, e.final_error);
+    if (e.aligned && e.align_start > 0.0)
+      std::printf("  start aligned       over the truth's first %.0f m: rotation %.3f deg (fit residual %.3f m)\n",
+                  e.align_start, e.align_yaw / kDeg, e.align_residual);
     if (e.has_sigma)
       std::printf("  within 3 sigma      %10.1f %% of epochs (mean NEES %.2f, 2 if consistent)\n",
                   100.0 * e.within_3sigma, e.mean_nees);
@@ -234,6 +249,9 @@ const bool registered = cli::register_command(
                    "Use every sample and module as it comes (no outage, saturation, slip or "
                    "fault isolation)");
       sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
+      sub.add_option("--align-start", a->align_start,
+                     "Evaluation: align the trajectory's first METRES of travel onto the truth's (default: 100 "
+                     "when the manifest has no initial heading, else 0 = off)");
       sub.add_option("--output-interval", a->output_interval, "Output interval [s]; 0 = every epoch");
       sub.add_option("--covariance-interval", a->covariance_interval,
                      "Covariance time update every this many seconds (F integrated in between); "

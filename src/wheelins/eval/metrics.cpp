@@ -11,6 +11,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "wheelins/eval/aligned_evaluator.hpp"
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/nav/types.hpp"
 
@@ -490,7 +491,7 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
   src.traj_has_heading = traj.has_heading;
   src.traj_has_roll_pitch = traj.has_roll_pitch;
   src.traj_has_sigma = traj.has_pos_std;
-  Evaluator ev(frame, src, opt, true);
+  StartAlignedEvaluator ev(frame, src, opt, true);
   if (truth.records.empty()) throw InputError(quote(truth.file) + ": no truth records");
   if (traj.records.empty()) throw InputError(quote(traj.file) + ": no trajectory records");
   // In step: the truth records before each trajectory record go in first.
@@ -612,6 +613,8 @@ std::string to_json(const EvalResult& r) {
   j.boolean("aligned", r.aligned);
   j.boolean("align_rotated", r.align_rotated);
   j.num("align_yaw_deg", r.align_yaw / kDeg);
+  j.num("align_start_m", r.align_start);
+  j.num("align_residual_m", r.align_residual);
   j.key("align_offset_ned_m");
   json_vec3(o, r.align_offset);
   j.key("antenna_m");

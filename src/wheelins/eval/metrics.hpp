@@ -77,6 +77,9 @@ constexpr double kMinSegment = 1.0, kMaxSegment = 1e6;
 struct EvalOptions {
   double segment_length = 100.0;  ///< l [m] of the drift rate
   bool align = false;             ///< shift + rotate the trajectory onto the truth at the start
+  /// > 0: the trajectory's start is aligned onto the truth's over this much of the truth's
+  /// travel [m] (a run without an initial heading; eval/alignment.hpp, StartAlignedEvaluator).
+  double align_start = 0.0;
   double max_gap = 5.0;           ///< [s] largest trajectory gap interpolated across
   /// The antenna (the truth's point) in the vehicle frame from the trajectory's reference
   /// point [m]: x forward, y right, z down.
@@ -129,7 +132,9 @@ struct EvalResult {
   bool aligned = false;
   bool align_rotated = false;         ///< heading part applied
   double align_yaw = 0.0;             ///< dpsi [rad]
-  Vec3 align_offset = Vec3::Zero();   ///< truth - trajectory position at the pivot [m]
+  Vec3 align_offset = Vec3::Zero();   ///< truth - trajectory position at the pivot [m]; start alignment: its shift
+  double align_start = 0.0;           ///< [m] of truth travel the start alignment used (0: none)
+  double align_residual = 0.0;        ///< [m] rms of the start alignment's fit
   std::vector<EpochError> series;     ///< one entry per evaluated epoch
 };
 

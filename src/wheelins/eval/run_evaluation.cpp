@@ -19,7 +19,7 @@ RunEvaluation::RunEvaluation(const std::filesystem::path& truth_file, const eart
   src.truth_layout = truth_layout_name(truth_->layout());
   src.truth_has_attitude = truth_->has_attitude();
   src.truth_has_velocity = truth_->has_velocity();
-  evaluator_ = std::make_unique<Evaluator>(earth::LocalFrame(origin), src, options.eval, false);
+  evaluator_ = std::make_unique<StartAlignedEvaluator>(earth::LocalFrame(origin), src, options.eval, false);
   have_next_truth_ = truth_->next(next_truth_);
 }
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "wheelins/eval/aligned_evaluator.hpp"
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/io/truth.hpp"
 
@@ -46,7 +47,7 @@ class RunEvaluation {
  private:
   void feed_truth_before(double t);
   std::unique_ptr<TruthReader> truth_;
-  std::unique_ptr<Evaluator> evaluator_;
+  std::unique_ptr<StartAlignedEvaluator> evaluator_;
   double truth_time_offset_ = 0.0;
   TruthRecord next_truth_;
   bool have_next_truth_ = false;

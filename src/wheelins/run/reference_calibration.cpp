@@ -129,7 +129,7 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     if (spec.kind != ModuleKind::kWheel) continue;
     WheelRadiusFit w;
     w.module = spec.name;
-    w.manifest_radius = spec.wheel_radius;
+    w.manifest_radius = m0.find(spec.name)->wheel_radius;
     w.radius = CalibratedValue{spec.wheel_radius, 0.0, false};
     const Mat3 C = wheel_sensor_to_body(spec);
     Sampled omega{&S[i], std::vector<double>(S[i].size())};

@@ -5,7 +5,9 @@
 #include <cctype>
 #include <set>
 
+#include "wheelins/eval/truth_quality.hpp"
 #include "wheelins/io/text_util.hpp"
+#include "wheelins/io/truth.hpp"
 #include "wheelins/survey/draft.hpp"
 #include "wheelins/util/interrupt.hpp"
 #include "wheelins/util/progress.hpp"
@@ -99,13 +101,23 @@ TableDatasetResult import_table_dataset(const TableDatasetOptions& o) {
   for (const auto& in : inputs)
     if (fs::exists(o.out_dir / (in.module + "_imu.bin"), ec)) existed.insert(o.out_dir / (in.module + "_imu.bin"));
   const fs::path manifest_file = o.out_dir / "manifest.yaml";
-  if (fs::exists(manifest_file, ec) && !o.overwrite)
-    throw InputError(quote(manifest_file) + ": exists; --force replaces it");
+  const fs::path truth_file = o.out_dir / "truth.bin";
+  for (const fs::path& f : {manifest_file, truth_file})
+    if ((f == manifest_file || o.truth) && fs::exists(f, ec) && !o.overwrite)
+      throw InputError(quote(f) + ": exists; --force replaces it");
+  // The reference is read (and refused) before anything is written.
+  std::optional<TruthData> truth;
+  if (o.truth) {
+    truth = read_truth(*o.truth);
+    if (truth->records.size() < 10) throw InputError(quote(*o.truth) + ": fewer than 10 records: too short a reference");
+  }
+  const bool truth_existed = fs::exists(truth_file, ec);
   r.tables = import_tables(inputs, o.out_dir, io);
   if (bar) bar->finish();
   std::vector<fs::path> created;
   for (const auto& t : r.tables)
     if (!existed.count(t.output)) created.push_back(t.output);
+  if (truth && !truth_existed) created.push_back(truth_file);
   try {
     // Survey the written files.
     std::vector<survey::ModuleInput> mods;
@@ -143,9 +155,38 @@ TableDatasetResult import_table_dataset(const TableDatasetOptions& o) {
       dopt.vehicle_type_given = true;
     }
     if (o.vehicle) dopt.vehicle_from = load_manifest(*o.vehicle, o.warn);
+    if (truth) {
+      // Its clock (time unit and offset) against the wheels', its quality, and its records
+      // with the unit applied (the offset goes into the manifest).
+      r.truth_clock = survey::fit_reference_clock(truth->records, series, sv);
+      const survey::ReferenceClockFit& c = *r.truth_clock;
+      std::vector<TruthRecord> recs = truth->records;
+      if (c.found)
+        for (TruthRecord& x : recs) x.t *= c.scale;
+      else if (o.warn)
+        o.warn(quote(*o.truth) + ": its clock could not be matched to the wheels' (no speed correlation); "
+               "written as read, truth_time_offset_s to be set");
+      TruthData scaled = *truth;
+      scaled.records = recs;
+      const std::string quality = eval::describe_truth_quality(eval::check_truth_quality(scaled));
+      if (!quality.empty()) r.draft.facts.push_back("reference: " + quality);
+      write_truth(truth_file, recs, truth->has_attitude ? TruthLayout::kGins11 : TruthLayout::kPos5, o.overwrite);
+      r.truth_file = truth_file;
+      r.truth_records = recs.size();
+      dopt.truth_file = truth_file.filename();
+      dopt.truth_clock = c;
+      // The origin: the reference where the static period ends (the vehicle stands there).
+      const double t0 = (sv.static_period ? sv.static_period->end : series.front().t_first) - (c.found ? c.offset : 0.0);
+      const TruthRecord* at = &recs.front();
+      for (const TruthRecord& x : recs)
+        if (std::abs(x.t - t0) < std::abs(at->t - t0)) at = &x;
+      dopt.origin = at->lla;
+    }
     dopt.name = o.out_dir.filename().string();
     dopt.source = std::to_string(r.tables.size()) + " table(s), preset " + map.preset;
+    std::vector<std::string> facts = std::move(r.draft.facts);
     r.draft = survey::draft_from_survey(sv, drafts, dopt);
+    r.draft.facts.insert(r.draft.facts.end(), facts.begin(), facts.end());
     save_manifest(r.draft.manifest, manifest_file, r.draft.notes);
     r.manifest_file = manifest_file;
   } catch (...) {

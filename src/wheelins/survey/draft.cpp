@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <algorithm>
 
 #include "wheelins/nav/types.hpp"
 
@@ -12,7 +14,12 @@ namespace {
 constexpr const char* kTodo = "TODO: measure";
 
 /// x rounded to a multiple of q (the precision the data give: the manifest stays readable).
-double round_to(double x, double q) { return std::round(x / q) * q; }
+double round_to(double x, double q) {
+  // Through text, so that the manifest shows the short number (not 847.8530000000001).
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", std::max(0, static_cast<int>(std::lround(-std::log10(q)))), std::round(x / q) * q);
+  return std::strtod(buf, nullptr);
+}
 
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
   char buf[200];
