@@ -112,7 +112,7 @@ const std::vector<std::string> kVehicleKeys = {"track_m", "wheelbase_m", "antenn
 const std::vector<std::string> kModuleKeys = {
     "name",          "kind",          "group",        "chip",      "file",
     "format",        "layout",        "rate_hz",      "time_offset_s", "position_v_m",
-    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "axle_axis",  "wheel_radius_m", "gyro_range_dps",
+    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "axle_axis",  "wheel_radius_m", "odometry_radius_m", "gyro_range_dps",
     "accel_range_m_s2", "noise"};
 
 /// One noise key: its name, its unit factor and the ImuNoise member it fills.
@@ -352,6 +352,10 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
   } else if (s.kind == ModuleKind::kWheel) {
     fail(path, "missing required key 'wheel_radius_m' (every wheel module needs its wheel radius)", &n);
   }
+  if (auto v = get(n, "odometry_radius_m"); v.IsDefined()) {
+    s.odometry_radius = number(v, join(path, "odometry_radius_m"));
+    range(s.odometry_radius, 0.01, 2.0, join(path, "odometry_radius_m"), v, "m (a wheel radius)");
+  }
   if (auto v = get(n, "gyro_range_dps"); v.IsDefined()) {
     const std::string p = join(path, "gyro_range_dps");
     range(number(v, p), 10.0, 1e5, p, v, "deg/s (the gyro's full scale)");
@@ -534,6 +538,9 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
              "+1: the axle axis points right, -1: left");
     if (wheel || s.wheel_radius != 0.0)
       w.line(4, "wheel_radius_m: " + num(s.wheel_radius), p + "wheel_radius_m");
+    if (s.odometry_radius > 0.0)
+      w.line(4, "odometry_radius_m: " + num(s.odometry_radius), p + "odometry_radius_m",
+             "for the raw axle rate (wheelins odometry)");
     if (s.gyro_range > 0.0)
       w.line(4, "gyro_range_dps: " + num(s.gyro_range, kDegU), p + "gyro_range_dps",
              "full scale: readings at it are saturated");

@@ -48,6 +48,10 @@ struct ModuleSpec : ImuModule {
   SampleFormat format = SampleFormat::kRate;
   FileLayout layout = FileLayout::kBinary;
   double time_offset = 0.0;     ///< added to the file's timestamps [s]
+  /// Wheel: the radius that turns this IMU's raw axle rate into speed (a plain odometer,
+  /// `wheelins odometry`), from a reference; 0: wheel_radius [m]. The filter's wheel_radius
+  /// differs from it by the axle gyro's scale factor, which the filter estimates.
+  double odometry_radius = 0.0;
 };
 
 struct Manifest {

@@ -68,7 +68,9 @@ OdometryResult run_wheel_odometry(const OdometryRequest& r) {
     };
     // Speeds of the wheels, the yaw rate (counter-clockwise from above), the speed at o.
     std::vector<double> v(nw);
-    for (std::size_t i = 0; i < nw; ++i) v[i] = -specs[i]->axle_sign * specs[i]->wheel_radius * body_rate(i).x();
+    for (std::size_t i = 0; i < nw; ++i)
+      v[i] = -specs[i]->axle_sign * (specs[i]->odometry_radius > 0.0 ? specs[i]->odometry_radius : specs[i]->wheel_radius) *
+             body_rate(i).x();
     const double yaw_up = gyro ? -body_rate(nw).z() : (v[1] - v[0]) / (specs[1]->p_inV.y() - specs[0]->p_inV.y());
     double vo = 0.0;
     for (std::size_t i = 0; i < nw; ++i) vo += v[i] - yaw_up * specs[i]->p_inV.y();

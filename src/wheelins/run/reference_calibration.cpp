@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/io/truth.hpp"
@@ -63,6 +64,94 @@ Fit2 ls2(const std::vector<double>& v, const std::vector<double>& x, const std::
   return f;
 }
 
+
+using survey::Signal;
+
+/// The least-squares scale k of v_ref(t) = k * x(t) + c * yaw(t) over the epochs after `from`
+/// faster than `min_speed` (both sides smoothed over 1 s; a second pass without residuals
+/// beyond 4 MADs); its 1 sigma from five parts of the drive or the fit's own, the larger.
+struct SpeedScale {
+  bool observed = false;
+  double scale = 0.0, sigma = 0.0, correlation = 0.0;
+  std::size_t epochs = 0;
+};
+
+template <class RefSpeed>
+SpeedScale fit_speed_scale(const RefSpeed& ref_speed, const Signal& x_sig, const Signal& yaw, double from_t,
+                           double min_speed) {
+  SpeedScale out;
+  const double step = 0.05;
+  const int smooth = static_cast<int>(std::lround(1.0 / step));
+  std::vector<double> v, x, y;
+  const double from = std::max(from_t, x_sig.start()), to = x_sig.end();
+  for (double t = from; t <= to; t += step) {
+    const double vr = ref_speed(t);
+    if (!std::isfinite(vr)) continue;
+    v.push_back(vr);
+    x.push_back(x_sig.at(t));
+    y.push_back(yaw.t.empty() ? 0.0 : yaw.at(t));
+  }
+  v = survey::moving_average(v, smooth);
+  x = survey::moving_average(x, smooth);
+  y = survey::moving_average(y, smooth);
+  std::vector<std::uint8_t> keep(v.size());
+  for (std::size_t k = 0; k < v.size(); ++k) keep[k] = v[k] >= min_speed;
+  Fit2 f = ls2(v, x, y, keep);
+  if (f.n >= 10) {
+    std::vector<double> res;
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (keep[k]) res.push_back(std::abs(v[k] - f.a * x[k] - f.b * y[k]));
+    std::nth_element(res.begin(), res.begin() + static_cast<std::ptrdiff_t>(res.size() / 2), res.end());
+    const double mad = res[res.size() / 2];
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (keep[k] && std::abs(v[k] - f.a * x[k] - f.b * y[k]) > 4.0 * 1.4826 * mad) keep[k] = 0;
+    f = ls2(v, x, y, keep);
+  }
+  out.epochs = f.n;
+  out.correlation = f.corr;
+  if (!(f.n >= 100 && f.a > 0.0)) return out;
+  std::vector<double> parts;
+  const std::size_t len = v.size() / 5;
+  for (std::size_t p = 0; p < 5 && len > 0; ++p) {
+    std::vector<std::uint8_t> kp(v.size(), 0);
+    for (std::size_t k = p * len; k < (p + 1) * len; ++k) kp[k] = keep[k];
+    const Fit2 fp = ls2(v, x, y, kp);
+    if (fp.n >= 40 && fp.a > 0.0) parts.push_back(fp.a);
+  }
+  double sd = f.sigma_a;
+  if (parts.size() >= 3) {
+    double mean = 0.0, ss = 0.0;
+    for (double a : parts) mean += a;
+    mean /= static_cast<double>(parts.size());
+    for (double a : parts) ss += (a - mean) * (a - mean);
+    sd = std::max(sd, std::sqrt(ss / static_cast<double>(parts.size() - 1) / static_cast<double>(parts.size())));
+  }
+  out.observed = true;
+  out.scale = f.a;
+  out.sigma = sd;
+  return out;
+}
+
+/// The horizontal speed a single Wheel-INS of `module` gives (its own Wheel-INS, the
+/// manifest's geometry as it is, no data checks) [m/s] at its records.
+Signal wheel_ins_speed(const Manifest& m, const std::string& module) {
+  RunRequest req;
+  req.manifest = m;
+  req.modules = {module};
+  req.calibration = CalibrationMode::kManifest;
+  req.data_checks = false;
+  req.progress = false;
+  req.nav.output_interval = 0.02;
+  req.warn = [](const std::string&) {};
+  Signal s;
+  req.on_record = [&](const TrajectoryRecord& r) {
+    s.t.push_back(r.t);
+    s.x.push_back(r.v_inN.head<2>().norm());
+  };
+  run_navigation(req);
+  return s;
+}
+
 }  // namespace
 
 ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::vector<std::string>& modules,
@@ -89,16 +178,24 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     S.push_back(survey::read_series(name, m.resolve(spec->file), imu_read_options(*spec)));
   }
   const survey::DatasetSurvey sv = survey::survey_series(S);
+  // Each module's gyro bias over the manifest's static period (the survey's where it has no data).
+  std::vector<Vec3> bias(S.size());
+  for (std::size_t i = 0; i < S.size(); ++i) {
+    Vec3 sum = Vec3::Zero();
+    double n = 0.0;
+    for (std::size_t k = S[i].index(m.static_start); k < S[i].size() && S[i].time(k) <= m.static_end; ++k)
+      if (S[i].time(k) >= m.static_start) sum += S[i].gyro[k], n += 1.0;
+    bias[i] = n >= 50.0 ? Vec3(sum / n) : sv.modules[i].traits.gyro_bias;
+  }
 
   // The vehicle's yaw rate (up positive): a Body-IMU's, else the unsteered wheels' mean.
   std::vector<Sampled> yaw_sources;
   for (std::size_t i = 0; i < modules.size(); ++i) {
     const ModuleSpec& spec = *m.find(modules[i]);
-    const survey::ModuleFinding& f = sv.modules[i];
     if (spec.kind != ModuleKind::kBody) continue;
     const Mat3 C = dcm_from_euler(spec.mounting_rpy);
     Sampled y{&S[i], std::vector<double>(S[i].size())};
-    for (std::size_t k = 0; k < S[i].size(); ++k) y.x[k] = -(C * (S[i].gyro[k] - f.traits.gyro_bias)).z();
+    for (std::size_t k = 0; k < S[i].size(); ++k) y.x[k] = -(C * (S[i].gyro[k] - bias[i])).z();
     yaw_sources.push_back(std::move(y));
     break;
   }
@@ -106,6 +203,19 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     for (std::size_t i = 0; i < modules.size(); ++i)
       if (sv.modules[i].kind == ModuleKind::kWheel && !sv.modules[i].steered)
         yaw_sources.push_back({&S[i], survey::yaw_rate(S[i], sv.modules[i].traits)});
+
+  // The yaw rate as one signal on the first source's bins (the mean of the sources).
+  Signal yaw;
+  if (!yaw_sources.empty()) {
+    const survey::Series& base = *yaw_sources.front().s;
+    for (std::size_t k = 0; k < base.size(); ++k) {
+      double y = 0.0;
+      for (const Sampled& src : yaw_sources) y += src.at(base.time(k));
+      yaw.t.push_back(base.time(k));
+      yaw.x.push_back(y / static_cast<double>(yaw_sources.size()));
+    }
+    yaw.step = base.dt;
+  }
 
   // The reference's speed at its records (central differences).
   std::vector<double> ref_v(ref.t.size(), 0.0);
@@ -121,9 +231,9 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     return (1.0 - a) * ref_v[k - 1] + a * ref_v[k];
   };
 
-  // Each wheel's radius.
-  const double step = 0.05;
-  const int smooth = static_cast<int>(std::lround(1.0 / step));
+  // Each wheel's radius: first from its turn rate, then from the speed its own Wheel-INS
+  // gives with that radius (the filter refines the axle gyro's scale factor against gravity,
+  // so the radius that makes the filter's speed right is what the run needs).
   for (std::size_t i = 0; i < modules.size(); ++i) {
     const ModuleSpec& spec = *m.find(modules[i]);
     if (spec.kind != ModuleKind::kWheel) continue;
@@ -132,64 +242,36 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     w.manifest_radius = m0.find(spec.name)->wheel_radius;
     w.radius = CalibratedValue{spec.wheel_radius, 0.0, false};
     const Mat3 C = wheel_sensor_to_body(spec);
-    Sampled omega{&S[i], std::vector<double>(S[i].size())};
-    for (std::size_t k = 0; k < S[i].size(); ++k)
-      omega.x[k] = -spec.axle_sign * (C * (S[i].gyro[k] - sv.modules[i].traits.gyro_bias)).x();
-    const double from = std::max({ref.t.front(), S[i].time(0), m.static_end});
-    const double to = std::min(ref.t.back(), S[i].time(S[i].size() - 1));
-    std::vector<double> v, x, y;
-    for (double t = from; t <= to; t += step) {
-      const double vr = ref_speed(t);
-      if (!std::isfinite(vr)) continue;
-      double yr = 0.0;
-      for (const Sampled& s : yaw_sources) yr += s.at(t);
-      v.push_back(vr);
-      x.push_back(omega.at(t));
-      y.push_back(yaw_sources.empty() ? 0.0 : yr / static_cast<double>(yaw_sources.size()));
+    Signal omega;
+    for (std::size_t k = 0; k < S[i].size(); ++k) {
+      omega.t.push_back(S[i].time(k));
+      omega.x.push_back(-spec.axle_sign * (C * (S[i].gyro[k] - bias[i])).x());
     }
-    v = survey::moving_average(v, smooth);
-    x = survey::moving_average(x, smooth);
-    y = survey::moving_average(y, smooth);
-    std::vector<std::uint8_t> keep(v.size());
-    for (std::size_t k = 0; k < v.size(); ++k) keep[k] = v[k] >= o.min_speed;
-    Fit2 f = ls2(v, x, y, keep);
-    if (f.n >= 10) {
-      // Again without the residuals beyond 4 MADs (a jump of the reference, a slipping wheel).
-      std::vector<double> res;
-      for (std::size_t k = 0; k < v.size(); ++k)
-        if (keep[k]) res.push_back(std::abs(v[k] - f.a * x[k] - f.b * y[k]));
-      std::nth_element(res.begin(), res.begin() + static_cast<std::ptrdiff_t>(res.size() / 2), res.end());
-      const double mad = res[res.size() / 2];
-      for (std::size_t k = 0; k < v.size(); ++k)
-        if (keep[k] && std::abs(v[k] - f.a * x[k] - f.b * y[k]) > 4.0 * 1.4826 * mad) keep[k] = 0;
-      f = ls2(v, x, y, keep);
-    }
-    w.epochs = f.n;
-    w.correlation = f.corr;
-    if (f.n >= 100 && f.a > 0.0) {
-      // 1 sigma from five parts of the drive.
-      std::vector<double> parts;
-      const std::size_t len = v.size() / 5;
-      for (int p = 0; p < 5 && len > 0; ++p) {
-        std::vector<std::uint8_t> kp(v.size(), 0);
-        for (std::size_t k = p * len; k < (p + 1) * len; ++k) kp[k] = keep[k];
-        const Fit2 fp = ls2(v, x, y, kp);
-        if (fp.n >= 40 && fp.a > 0.0) parts.push_back(fp.a);
-      }
-      double sd = f.sigma_a;
-      if (parts.size() >= 3) {
-        double mean = 0.0, ss = 0.0;
-        for (double a : parts) mean += a;
-        mean /= static_cast<double>(parts.size());
-        for (double a : parts) ss += (a - mean) * (a - mean);
-        sd = std::max(sd, std::sqrt(ss / static_cast<double>(parts.size() - 1) / static_cast<double>(parts.size())));
-      }
-      w.radius = CalibratedValue{f.a, sd, sd < 0.05 * f.a};
-      if (!w.radius.observed) w.radius.value = spec.wheel_radius;
-    } else {
+    omega.step = S[i].dt;
+    const SpeedScale first = fit_speed_scale(ref_speed, omega, yaw, m.static_end, o.min_speed);
+    w.epochs = first.epochs;
+    w.correlation = first.correlation;
+    if (!first.observed) {
       out.notes.push_back(spec.name + fmt(": %.0f epochs faster than %.1f m/s against the reference: the radius is not observed",
-                                          static_cast<double>(f.n), o.min_speed));
+                                          static_cast<double>(first.epochs), o.min_speed));
+      out.wheels.push_back(w);
+      continue;
     }
+    w.radius = CalibratedValue{first.scale, first.sigma, true};
+    w.odometry_radius = w.radius;
+    // The second pass: the filter's speed with the first radius.
+    Manifest one = m;
+    for (auto& x : one.modules)
+      if (x.name == spec.name) x.wheel_radius = first.scale;
+    one.heading_known = false;
+    const Signal filter_speed = wheel_ins_speed(one, spec.name);
+    const SpeedScale second = fit_speed_scale(ref_speed, filter_speed, yaw, m.static_end, o.min_speed);
+    if (second.observed) {
+      w.radius = CalibratedValue{first.scale * second.scale, first.scale * second.sigma, true};
+      w.correlation = second.correlation;
+      w.epochs = second.epochs;
+    }
+    if (!(w.radius.std < 0.05 * w.radius.value)) w.radius = CalibratedValue{spec.wheel_radius, w.radius.std, false};
     out.wheels.push_back(w);
   }
 
@@ -233,8 +315,17 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     if (a.found) {
       out.initial_heading = CalibratedValue{a.yaw, a.yaw_sigma, a.yaw_sigma < 5.0 * kDeg};
       if (o.estimate_antenna) {
-        out.antenna_forward = CalibratedValue{a.antenna.x(), a.antenna_sigma.x(), a.antenna_sigma.x() < 0.5};
-        out.antenna_right = CalibratedValue{a.antenna.y(), a.antenna_sigma.y(), a.antenna_sigma.y() < 0.5};
+        // Observed only where the drive's turns determine it, and on the vehicle: a drive
+        // without turns trades the antenna for the start (the fit then lands metres off).
+        const double reach_x = std::max(2.0, m.wheelbase + 1.5), reach_y = std::max(1.0, 0.5 * m.track_width + 0.5);
+        const bool on_vehicle = std::abs(a.antenna.x()) <= reach_x && std::abs(a.antenna.y()) <= reach_y;
+        const bool sharp = a.antenna_sigma.maxCoeff() < o.max_antenna_sigma;
+        out.antenna_forward = CalibratedValue{a.antenna.x(), a.antenna_sigma.x(), on_vehicle && sharp};
+        out.antenna_right = CalibratedValue{a.antenna.y(), a.antenna_sigma.y(), on_vehicle && sharp};
+        if (!on_vehicle || !sharp)
+          out.notes.push_back(fmt("the antenna (forward %.2f +- %.2f m, right %.2f +- %.2f m) is not determined by this drive",
+                                  a.antenna.x(), a.antenna_sigma.x(), a.antenna.y(), a.antenna_sigma.y()) +
+                              (on_vehicle ? " (too few turns): the manifest's kept" : " (off the vehicle): the manifest's kept"));
       }
     } else {
       out.notes.push_back("the dead reckoning could not be aligned onto the reference (too few common epochs)");
@@ -250,6 +341,10 @@ Manifest apply_reference_calibration(Manifest m, const ReferenceCalibration& cal
     if (w.radius.observed)
       for (auto& s : m.modules)
         if (s.name == w.module) s.wheel_radius = w.radius.value;
+  for (const WheelRadiusFit& w : cal.wheels)
+    if (w.odometry_radius.observed)
+      for (auto& s : m.modules)
+        if (s.name == w.module) s.odometry_radius = w.odometry_radius.value;
   if (cal.initial_heading.observed) {
     m.initial_heading = wrap_pi(cal.initial_heading.value);
     m.heading_known = true;
@@ -268,7 +363,8 @@ std::string reference_calibration_report(const ReferenceCalibration& c) {
   for (const WheelRadiusFit& w : c.wheels)
     s += "  " + w.module + fmt(std::string(std::max<int>(1, 12 - static_cast<int>(w.module.size())), ' ').append("wheel radius %.4f +- %.4f m (%.4f)").c_str(),
                                w.radius.value, w.radius.std, w.manifest_radius) +
-         (w.radius.observed ? fmt("  %.0f epochs, correlation %.4f\n", static_cast<double>(w.epochs), w.correlation)
+         (w.radius.observed ? fmt("  %.0f epochs, correlation %.4f; raw axle rate %.4f m\n", static_cast<double>(w.epochs),
+                                  w.correlation, w.odometry_radius.value)
                             : std::string("  not observed: manifest kept\n"));
   const auto& a = c.alignment;
   s += fmt("  initial heading  %.3f +- %.3f deg", c.initial_heading.value / kDeg, c.initial_heading.std / kDeg) +
@@ -289,7 +385,8 @@ std::string reference_calibration_yaml(const ReferenceCalibration& c, const Mani
   };
   std::string s = "reference:\n  wheels:\n";
   for (const WheelRadiusFit& w : c.wheels)
-    s += "    " + io_detail::json_quote(w.module) + ":\n      wheel_radius_m: " + val(w.radius, 1.0, w.manifest_radius) + "\n";
+    s += "    " + io_detail::json_quote(w.module) + ":\n      wheel_radius_m: " + val(w.radius, 1.0, w.manifest_radius) +
+         "\n      odometry_radius_m: " + val(w.odometry_radius, 1.0, w.manifest_radius) + "\n";
   s += "  initial:\n    heading_deg: " + val(c.initial_heading, 1.0 / kDeg, m.initial_heading) + "\n";
   s += "  vehicle:\n    antenna_forward_m: " + val(c.antenna_forward, 1.0, m.antenna_inV ? m.antenna_inV->x() : 0.0) + "\n";
   s += "    antenna_right_m: " + val(c.antenna_right, 1.0, m.antenna_inV ? m.antenna_inV->y() : 0.0) + "\n";

@@ -27,12 +27,14 @@ struct ReferenceCalibrationOptions {
   double min_speed = 1.5;        ///< [m/s] reference speed of the epochs the radius uses
   double align_length = 300.0;   ///< [m] of the reference's travel the heading fit uses (<= 0: all)
   bool estimate_antenna = true;
+  double max_antenna_sigma = 0.15;  ///< [m] the antenna is taken as observed below this 1 sigma
   bool progress = false;
 };
 
 struct WheelRadiusFit {
   std::string module;
-  CalibratedValue radius;     ///< [m]
+  CalibratedValue radius;     ///< [m] for the filter (its own speed against the reference)
+  CalibratedValue odometry_radius;  ///< [m] for the raw axle rate (a plain odometer)
   double manifest_radius = 0.0;
   double correlation = 0.0;   ///< of the reference's speed and the fit
   std::size_t epochs = 0;

@@ -218,6 +218,75 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
   auto common = [&](std::size_t i, const std::vector<double>& x) {
     return shifted(signal(i, x), out.modules[i].clock.found ? out.modules[i].clock.offset : 0.0);
   };
+  // The static period: the first interval in which every wheel rests (or every body).
+  const std::vector<int>& still_set = wheels.empty() ? bodies : wheels;
+  double from = -1e300, to = 1e300;
+  for (int k : still_set) {
+    from = std::max(from, out.modules[static_cast<std::size_t>(k)].start);
+    const std::size_t i = static_cast<std::size_t>(k);
+    to = std::min(to, S[i].t_last + (out.modules[i].clock.found ? out.modules[i].clock.offset : 0.0));
+  }
+  std::vector<Signal> masks;
+  for (int k : still_set) {
+    const std::size_t i = static_cast<std::size_t>(k);
+    const auto m = rest_mask(S[i], out.modules[i].traits);
+    masks.push_back(common(i, std::vector<double>(m.begin(), m.end())));
+  }
+  double run_start = std::nan("");
+  for (double t = from; t <= to; t += step) {
+    bool all = !masks.empty();
+    for (const Signal& m : masks) all = all && m.at(t) > 0.5;
+    if (all && std::isnan(run_start)) run_start = t;
+    if (!all && !std::isnan(run_start)) {
+      if (t - run_start >= o.min_static + 2.0 * o.static_margin) {
+        out.static_period = Interval{run_start + o.static_margin, t - o.static_margin};
+        break;
+      }
+      run_start = std::nan("");
+    }
+  }
+
+
+  // A body rests when the wheels do (a car body's own rates are too quiet to tell rest from
+  // a smooth drive): its bias and up-axis from those bins, its yaw rate again with them.
+  if (!wheels.empty() && !masks.empty())
+    for (int b : bodies) {
+      const std::size_t i = static_cast<std::size_t>(b);
+      ModuleFinding& f = out.modules[i];
+      const double off = f.clock.found ? f.clock.offset : 0.0;
+      std::vector<std::uint8_t> rest(S[i].size(), 0);
+      for (std::size_t k = 0; k < S[i].size(); ++k) {
+        const double t = S[i].time(k) + off;
+        bool all = t >= from && t <= to;
+        for (const Signal& m : masks) all = all && m.at(t) > 0.5;
+        rest[k] = all;
+      }
+      std::vector<Interval> iv;
+      Vec3 gs = Vec3::Zero(), fs = Vec3::Zero();
+      double n_rest = 0.0;
+      for (std::size_t k = 0; k < rest.size();) {
+        if (!rest[k]) {
+          ++k;
+          continue;
+        }
+        std::size_t j = k;
+        while (j < rest.size() && rest[j]) ++j;
+        const Interval r{S[i].t0 + static_cast<double>(k) * S[i].dt, S[i].t0 + static_cast<double>(j) * S[i].dt};
+        if (r.length() >= o.traits.min_rest) {
+          iv.push_back(r);
+          for (std::size_t q = k; q < j; ++q) gs += S[i].gyro[q], fs += S[i].accel[q], n_rest += 1.0;
+        }
+        k = j;
+      }
+      if (n_rest > 0.0) {
+        f.traits.rest = iv;
+        f.traits.rest_found = true;
+        f.traits.gyro_bias = gs / n_rest;
+        f.traits.up = fs.normalized();
+        yaw[i] = moving_average(yaw_rate(S[i], f.traits), std::max(1, static_cast<int>(std::lround(0.2 / S[i].dt))));
+      }
+    }
+
   // The vehicle's yaw rate: the reference body's, else the first wheel's.
   std::optional<Signal> vehicle_yaw;
   if (!bodies.empty()) vehicle_yaw = common(static_cast<std::size_t>(bodies.front()), yaw[static_cast<std::size_t>(bodies.front())]);
@@ -344,34 +413,6 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
       f.forward = fwd;
       f.left = lft;
       f.axes_found = f.forward_fit > 0.5;
-    }
-  }
-
-  // The static period: the first interval in which every wheel rests (or every body).
-  const std::vector<int>& still_set = wheels.empty() ? bodies : wheels;
-  double from = -1e300, to = 1e300;
-  for (int k : still_set) {
-    from = std::max(from, out.modules[static_cast<std::size_t>(k)].start);
-    const std::size_t i = static_cast<std::size_t>(k);
-    to = std::min(to, S[i].t_last + (out.modules[i].clock.found ? out.modules[i].clock.offset : 0.0));
-  }
-  std::vector<Signal> masks;
-  for (int k : still_set) {
-    const std::size_t i = static_cast<std::size_t>(k);
-    const auto m = rest_mask(S[i], out.modules[i].traits);
-    masks.push_back(common(i, std::vector<double>(m.begin(), m.end())));
-  }
-  double run_start = std::nan("");
-  for (double t = from; t <= to; t += step) {
-    bool all = !masks.empty();
-    for (const Signal& m : masks) all = all && m.at(t) > 0.5;
-    if (all && std::isnan(run_start)) run_start = t;
-    if (!all && !std::isnan(run_start)) {
-      if (t - run_start >= o.min_static + 2.0 * o.static_margin) {
-        out.static_period = Interval{run_start + o.static_margin, t - o.static_margin};
-        break;
-      }
-      run_start = std::nan("");
     }
   }
 

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# The recipe of docs/real-data.md on the real car recordings (../shared/data/wmi-car):
+# each trial imported from the raw DOT and GNSS files, calibrated against its GNSS
+# (calibrate --reference), and navigated with the vehicle calibrated on the OTHER trial
+# (import --vehicle) and no reference, then scored against its GNSS with the start aligned
+# over the first 100 m (the initial heading from the reference at the start, as the paper
+# takes it). Prints a table of final horizontal error over distance and drift rate per
+# configuration, and the naive dead reckoning for comparison.
+# Usage: scripts/real-data.sh [BIN] [DATA_DIR] [OUT_DIR]
+set -euo pipefail
+bin=${1:-build/wheelins}
+data=${2:-../shared/data/wmi-car}
+out=${3:-out/real-data}
+trials=(trial02 trial04)
+mkdir -p "$out"
+for t in "${trials[@]}"; do
+  rm -rf "$out/$t"
+  "$bin" import "$data/$t" --preset xsens-dot --truth "$data/$t/GNSS.csv" --out "$out/$t" -q > "$out/$t.import.txt"
+  "$bin" calibrate -m "$out/$t/manifest.yaml" --reference -o "$out/$t/calibrated.yaml" -q > "$out/$t.calibrate.txt" 2>&1
+done
+printf "%-8s %-24s %10s %10s %10s\n" trial configuration "final %" "drift %" "heading"
+for t in "${trials[@]}"; do
+  other=$([ "$t" = trial02 ] && echo trial04 || echo trial02)
+  rm -rf "$out/$t-x"
+  "$bin" import "$data/$t" --preset xsens-dot --truth "$data/$t/GNSS.csv" --vehicle "$out/$other/calibrated.yaml" \
+    --out "$out/$t-x" -q > /dev/null
+  row() {
+    local name=$1; shift
+    local text
+    text=$("$@" 2>/dev/null)
+    printf "%-8s %-24s %10s %10s %10s\n" "$t" "$name" \
+      "$(awk '/^  final error /{print $3}' <<< "$text")" "$(awk '/^  drift rate /{print $3}' <<< "$text")" \
+      "$(awk '/^  heading RMSE /{print $3}' <<< "$text")"
+  }
+  m="$out/$t-x/manifest.yaml"
+  row "single (left rear)" "$bin" run -m "$m" -c single -o "$out/$t-x/single" -q --formats tum
+  row "single (right rear)" "$bin" run -m "$m" -c single-right -o "$out/$t-x/single-right" -q --formats tum
+  row "dual (rear pair)" "$bin" run -m "$m" -c dual-wheel -o "$out/$t-x/dual" -q --formats tum
+  row "body/wheel" "$bin" run -m "$m" -c body-wheel -o "$out/$t-x/body-wheel" -q --formats tum
+  row "triple" "$bin" run -m "$m" -c triple -o "$out/$t-x/triple" -q --formats tum
+  row "triple centralized" "$bin" run -m "$m" -c triple --centralized -o "$out/$t-x/triple-c" -q --formats tum
+  row "naive dead reckoning" "$bin" odometry -m "$m"
+done
