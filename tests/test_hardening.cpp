@@ -153,7 +153,7 @@ TEST_F(Hardening, SampleBeyondTheSensorRangeIsIsolatedNeverNaN) {
   std::vector<std::string> warnings;
   r.warn = [&](const std::string& w) { warnings.push_back(w); };
   const RunResult res = run_navigation(r);
-  EXPECT_HAS(res.fault_report, "2 samples beyond the sensor range left out");
+  EXPECT_HAS(res.fault_report, "2 samples beyond the sensor range or not finite left out");
   ASSERT_FALSE(warnings.empty());
   EXPECT_HAS(warnings.front(), "record 7000");
   const TrajectoryData traj = read_trajectory(d / "out" / "trajectory.csv");
@@ -163,6 +163,31 @@ TEST_F(Hardening, SampleBeyondTheSensorRangeIsIsolatedNeverNaN) {
   r.nav.faults.enabled = false;  // without fault handling: a clear error, nothing written
   r.output_dir = d / "out2";
   EXPECT_HAS(error_of([&] { run_navigation(r); }), "record 7000 (0-based");
+  EXPECT_FALSE(fs::exists(d / "out2"));
+}
+
+TEST_F(Hardening, NonFiniteSampleIsAFaultLikeOneBeyondTheRange) {
+  // One policy for a sample that cannot be: with fault handling it is left out and counted,
+  // as one beyond the range; without, the run stops naming the file and the record.
+  const fs::path d = variant("nan");
+  edit_rows(d / "right-wheel-imu" / "tri_C1_imu.bin", [](std::vector<double>& v) {
+    v[7 * 7000 + 5] = std::numeric_limits<double>::quiet_NaN();
+    v[7 * 7200 + 2] = std::numeric_limits<double>::infinity();
+  });
+  RunRequest r = request(d, "triple", d / "out");
+  std::vector<std::string> warnings;
+  r.warn = [&](const std::string& w) { warnings.push_back(w); };
+  const RunResult res = run_navigation(r);
+  EXPECT_HAS(res.fault_report, "2 samples beyond the sensor range or not finite left out");
+  bool named = false;
+  for (const auto& w : warnings) named = named || (w.find("record 7000") != std::string::npos && w.find("not finite") != std::string::npos);
+  EXPECT_TRUE(named);
+  const TrajectoryData traj = read_trajectory(d / "out" / "trajectory.csv");
+  for (const auto& rec : traj.records) ASSERT_TRUE(rec.p_inN.allFinite() && rec.v_inN.allFinite()) << rec.t;
+  EXPECT_HAS(read_all(d / "out" / "faults.csv"), "samples_beyond_range,2");
+  r.nav.faults.enabled = false;
+  r.output_dir = d / "out2";
+  EXPECT_HAS(error_of([&] { run_navigation(r); }), "record 7000 (0-based), column 5 (accel_x): value is NaN");
   EXPECT_FALSE(fs::exists(d / "out2"));
 }
 

@@ -44,6 +44,10 @@ struct ImuReadOptions {
   double gap_factor = 5.0;    ///< an interval longer than gap_factor / rate_hz is a gap
   WarningSink warn;           ///< receives one message per gap (up to max_gap_warnings); may be empty
   int max_gap_warnings = 10;  ///< then one "further gaps ..." message, the rest only counted
+  /// A NaN or infinite gyro or accelerometer value is passed on (the run's input checks
+  /// leave the sample out as a fault, as one beyond the sensor range) instead of being an
+  /// error; a non-finite time is an error either way.
+  bool pass_nonfinite = false;
 };
 
 /// The read options a manifest gives a module (rate, format, layout, time offset).

@@ -121,7 +121,9 @@ InstallationCalibration calibrate_installation(
     const ModuleSpec* spec = specs[k];
     // The samples the navigator will see: the same reader and input checks, with their
     // warnings left to the navigation pass (which reads the same file again).
-    auto reader = std::make_unique<ImuFileReader>(m.resolve(spec->file), imu_read_options(*spec, {}));
+    ImuReadOptions ro = imu_read_options(*spec, {});
+    ro.pass_nonfinite = isolate_faults;  // as the run reads them
+    auto reader = std::make_unique<ImuFileReader>(m.resolve(spec->file), ro);
     CheckedStream stream(std::move(reader), *spec, m, isolate_faults, WarningSink{});
     ImuSample s;
     while (stream.next(s) && s.t <= t_end) {

@@ -37,7 +37,8 @@ bool InputChecks::admit(ImuSample& s, std::uint64_t index) {
   check_rate(s);
   // The format first (from the first static samples, before any is judged by range):
   // rates read as increments, or the reverse, are off by the rate in every figure.
-  if (!format_checked_) {
+  const bool finite = s.dtheta.allFinite() && s.dvel.allFinite();
+  if (!format_checked_ && finite) {
     if (s.t >= static_start_ && s.t <= static_end_) {
       fmt_sum_ += s.dvel.norm();
       fmt_time_ += s.dt;
@@ -48,8 +49,9 @@ bool InputChecks::admit(ImuSample& s, std::uint64_t index) {
   }
   const double dt = s.dt;
   const double w = s.dtheta.cwiseAbs().maxCoeff() / dt, f = s.dvel.cwiseAbs().maxCoeff() / dt;
-  if (!(w <= gyro_limit_) || !(f <= accel_limit_)) {
-    out_of_range(s, w > gyro_limit_, index);
+  // (maxCoeff may pass over a NaN: finiteness is checked on its own.)
+  if (!finite || !(w <= gyro_limit_) || !(f <= accel_limit_)) {
+    out_of_range(s, !s.dtheta.allFinite() || w > gyro_limit_, index);
     return false;
   }
   if (carry_ > 0.0) {  // the samples left out: their interval at this sample's rate
@@ -81,7 +83,9 @@ void InputChecks::finish() {
 void InputChecks::out_of_range(const ImuSample& s, bool gyro, std::uint64_t index) {
   const double lim = gyro ? gyro_limit_ : accel_limit_;
   const Vec3 v = (gyro ? s.dtheta : s.dvel) / s.dt;
-  std::string what = std::string(gyro ? "gyro" : "accelerometer") + " reading " +
+  const bool finite = s.dtheta.allFinite() && s.dvel.allFinite();
+  std::string what = !finite ? std::string("a reading that is not finite (NaN or infinite)") :
+                     std::string(gyro ? "gyro" : "accelerometer") + " reading " +
                      fmt(v.cwiseAbs().maxCoeff(), "%.4g") + (gyro ? " rad/s" : " m/s^2") +
                      " beyond the sensor range " + fmt(lim, "%.4g") + (gyro ? " rad/s" : " m/s^2") +
                      ((gyro ? spec_.gyro_range : spec_.accel_range) > 0.0

@@ -175,7 +175,9 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
   for (const auto& name : modules) {
     const ModuleSpec* spec = m.find(name);
     if (!spec) throw InputError(quote(m.path) + ": no module named '" + name + "'");
-    S.push_back(survey::read_series(name, m.resolve(spec->file), imu_read_options(*spec)));
+    ImuReadOptions ro = imu_read_options(*spec);
+    ro.pass_nonfinite = true;
+    S.push_back(survey::read_series(name, m.resolve(spec->file), ro));
   }
   const survey::DatasetSurvey sv = survey::survey_series(S);
   // Each module's gyro bias over the manifest's static period (the survey's where it has no data).

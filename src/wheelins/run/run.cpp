@@ -167,7 +167,9 @@ RunResult run_navigation(const RunRequest& r) {
   for (const auto& name : r.modules) {
     const ModuleSpec* spec = r.manifest.find(name);
     const fs::path file = r.manifest.resolve(spec->file);
-    auto reader = std::make_unique<ImuFileReader>(file, imu_read_options(*spec, r.warn));
+    ImuReadOptions ro = imu_read_options(*spec, r.warn);
+    ro.pass_nonfinite = r.nav.faults.enabled;  // one policy for a sample that cannot be: a fault
+    auto reader = std::make_unique<ImuFileReader>(file, ro);
     auto c = std::make_unique<CheckedStream>(std::move(reader), *spec, r.manifest, r.nav.faults.enabled, r.warn);
     checked.push_back(c.get());
     readers.push_back(std::move(c));
@@ -293,7 +295,7 @@ RunResult run_navigation(const RunRequest& r) {
   for (std::size_t i = 0; i < checked.size(); ++i)
     if (checked[i]->dropped())
       input_faults += "  " + r.modules[i] + ": " + std::to_string(checked[i]->dropped()) +
-                      " samples beyond the sensor range left out (" + quote(checked[i]->reader().file()) + ")\n";
+                      " samples beyond the sensor range or not finite left out (" + quote(checked[i]->reader().file()) + ")\n";
   if (out_dir) {
     std::string csv = fault_report_csv(nav.faults());
     for (std::size_t i = 0; i < checked.size(); ++i)

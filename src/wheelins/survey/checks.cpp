@@ -41,6 +41,7 @@ std::vector<ModuleInput> survey_inputs(const Manifest& m, const std::vector<std:
     x.name = name;
     x.file = m.resolve(s->file);
     x.read = imu_read_options(*s);
+    x.read.pass_nonfinite = true;  // left out like a sample beyond the range (series.hpp)
     if (s->gyro_range > 0.0) x.gyro_limit = 1.05 * s->gyro_range;
     if (s->accel_range > 0.0) x.accel_limit = 1.05 * s->accel_range;
     in.push_back(std::move(x));

@@ -69,6 +69,30 @@ ClockFit combine(const ClockFit& a, const ClockFit& b, double sign_b) {
   return c;
 }
 
+/// A body's horizontal acceleration's size: its specific force less its mean at rest, the
+/// part along its up-axis taken out, over 0.25 s.
+std::vector<double> horizontal_acceleration(const Series& s, const ModuleTraits& t) {
+  Vec3 g = Vec3::Zero();
+  double n = 0.0;
+  for (const Interval& iv : t.rest)
+    for (std::size_t k = s.index(iv.start); k < s.size() && s.time(k) < iv.end; ++k) g += s.accel[k], n += 1.0;
+  if (n > 0.0) g /= n;
+  std::vector<double> out(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const Vec3 a = s.accel[k] - g;
+    out[k] = (a - a.dot(t.up) * t.up).norm();
+  }
+  return moving_average(out, std::max(1, static_cast<int>(std::lround(0.25 / s.dt))));
+}
+
+/// A wheel's acceleration's size in turns: |d(spin rate)/dt| over 0.25 s.
+std::vector<double> wheel_acceleration(const Series& s, const std::vector<double>& spin) {
+  const std::vector<double> w = moving_average(spin, std::max(1, static_cast<int>(std::lround(0.25 / s.dt))));
+  std::vector<double> out(w.size(), 0.0);
+  for (std::size_t k = 1; k + 1 < w.size(); ++k) out[k] = std::abs(w[k + 1] - w[k - 1]) / (2.0 * s.dt);
+  return moving_average(out, std::max(1, static_cast<int>(std::lround(0.25 / s.dt))));
+}
+
 }  // namespace
 
 const ModuleFinding* DatasetSurvey::find(const std::string& name) const {
@@ -137,6 +161,7 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
           basis = "yaw rate against " + S[w0].module;
         }
       }
+      if (!(f.correlation >= o.min_clock_correlation)) f.found = false;  // no common motion to tell
       to_w0[i] = f;
       out.modules[i].clock_basis = basis;
     }
@@ -144,7 +169,7 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
   // Bodies against the wheel whose yaw rate matches best (an unsteered one).
   std::vector<ClockFit> to_ref(n);
   if (!bodies.empty()) {
-    const std::size_t ref = static_cast<std::size_t>(bodies.front());
+    std::size_t ref = static_cast<std::size_t>(bodies.front());
     for (int b : bodies) {
       const std::size_t i = static_cast<std::size_t>(b);
       ClockFit best;
@@ -158,35 +183,60 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
           basis = "yaw rate against " + S[ref].module;
         }
       } else {
-        // o_(b, w0) = o_(b, j) - o_(w0, j) for the best wheel j.
+        // o_(b, w0) = o_(b, j) - o_(w0, j) for the best wheel j: by the yaw rates, else (a
+        // drive without turns) by the size of the horizontal acceleration.
         for (int w : wheels) {
           const std::size_t j = static_cast<std::size_t>(w);
           if (!to_w0[j].found) continue;
           const ClockFit f = fit_clock_offset(signal(i, yaw[i]), signal(j, yaw[j]), o.clock);
-          if (f.found && (!best.found || f.correlation > best.correlation)) {
+          if (f.found && f.correlation >= o.min_clock_correlation && (!best.found || f.correlation > best.correlation)) {
             best = combine(f, to_w0[j], -1.0);
             basis = "yaw rate against " + S[j].module;
+          }
+        }
+        if (!best.found) {
+          const std::size_t j = static_cast<std::size_t>(wheels.front());
+          const ClockFit f = fit_clock_offset(signal(i, horizontal_acceleration(S[i], out.modules[i].traits)),
+                                              signal(j, wheel_acceleration(S[j], spin[j])), o.clock);
+          if (f.found && f.correlation >= o.min_clock_correlation) {
+            best = combine(f, to_w0[j], -1.0);
+            basis = "acceleration against " + S[j].module;
+          } else {
+            best = ClockFit{};
+            basis = "not found (no common turning or acceleration)";
           }
         }
       }
       to_ref[i] = best;  // for now: body clock -> w0 clock, inverted below
       out.modules[i].clock_basis = basis;
     }
-    // The reference is the first body: every offset becomes "to the reference's clock".
-    const ClockFit ref_to_w0 = wheels.empty() ? ClockFit{true, 0.0, 0.0, 1.0, 0.0} : to_ref[ref];
+    // The reference is the first body tied to the wheels: every offset becomes "to the
+    // reference's clock". A body tied to none keeps its clock unknown; with no body tied,
+    // the first wheel's clock is the reference.
+    for (int b : bodies)
+      if (wheels.empty() || to_ref[static_cast<std::size_t>(b)].found) {
+        ref = static_cast<std::size_t>(b);
+        break;
+      }
+    const bool ref_tied = wheels.empty() || to_ref[ref].found;
+    const ClockFit ref_to_w0 = wheels.empty() ? ClockFit{true, 0.0, 0.0, 1.0, 0.0}
+                               : ref_tied   ? to_ref[ref]
+                                            : ClockFit{true, 0.0, 0.0, 1.0, 0.0};
+    if (!ref_tied) ref = static_cast<std::size_t>(wheels.front());
+    const std::string ref_basis = out.modules[ref].clock_basis;
     for (std::size_t i = 0; i < n; ++i) {
       ModuleFinding& f = out.modules[i];
       if (i == ref) {
         f.clock = ClockFit{true, 0.0, 0.0, 1.0, 0.0};
         f.clock_reference = true;
         f.clock_basis = "the reference clock";
+      } else if (f.kind == ModuleKind::kWheel && !ref_tied) {
+        f.clock = to_w0[i];
       } else if (f.kind == ModuleKind::kWheel) {
-        // t_ref = t_w0 - o_(ref? ) : o(b, w0) from above maps w0 -> ... see below
-        ClockFit c = to_w0[i];
-        // to_ref[ref] holds o_(ref, w0) with t_ref = t_w0 + o_(ref, w0)?  fit(a=ref, b=w0)
-        // gives t_ref = t_w0 + o; wheel i: t_w0 = t_i + to_w0[i].
-        c = combine(c, ref_to_w0, +1.0);
-        f.clock = c;
+        // t_ref = t_w0 + o_(ref, w0) and t_w0 = t_i + o_(w0, i).
+        f.clock = combine(to_w0[i], ref_to_w0, +1.0);
+        if (static_cast<int>(i) == wheels.front())
+          f.clock_basis = "the reference " + S[ref].module + "'s " + ref_basis;
       } else if (!wheels.empty()) {
         // Another body: t_w0 = t_b - to_ref[b]... fit(a=b, b=j) gives t_b = t_j + o, so
         // t_j = t_b - o and t_ref = t_w0 + o_ref: t_ref = t_b - o_(b,w0) + o_(ref,w0).

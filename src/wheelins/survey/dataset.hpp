@@ -50,6 +50,7 @@ struct SurveyOptions {
   double steering_lead = 0.2;    ///< [s] a steered wheel's yaw rate leads the vehicle's by more
   double min_turning = 0.03;     ///< [rad/s] rms yaw rate of the vehicle below which steering is not judged
   double min_forward = 0.5;      ///< |spin direction| below this: the way forward is not clear
+  double min_clock_correlation = 0.5;  ///< a clock fit below this correlation is not taken
 };
 
 struct ModuleFinding {

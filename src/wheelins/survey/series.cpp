@@ -37,7 +37,8 @@ Series read_series(const std::string& module, const std::filesystem::path& file,
       continue;
     }
     ++s.samples;
-    if (!(x.dt > 0.0) || !((x.dtheta / x.dt).cwiseAbs().maxCoeff() <= o.gyro_limit) ||
+    if (!(x.dt > 0.0) || !x.dtheta.allFinite() || !x.dvel.allFinite() ||
+        !((x.dtheta / x.dt).cwiseAbs().maxCoeff() <= o.gyro_limit) ||
         !((x.dvel / x.dt).cwiseAbs().maxCoeff() <= o.accel_limit)) {
       ++s.left_out;
       continue;
