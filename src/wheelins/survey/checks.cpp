@@ -12,10 +12,15 @@ namespace {
 
 using io_detail::format_double;
 
+/// printf of up to three numbers, as long as it takes (the steering warning alone is over
+/// 200 characters).
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
+  const int n = std::snprintf(nullptr, 0, f, a, b, c);
+  if (n <= 0) return {};
+  std::string out(static_cast<std::size_t>(n) + 1, '\0');
+  std::snprintf(out.data(), out.size(), f, a, b, c);
+  out.resize(static_cast<std::size_t>(n));
+  return out;
 }
 
 std::string axis_name(const Vec3& u) {
