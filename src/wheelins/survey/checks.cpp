@@ -67,12 +67,18 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
   for (const auto& f : survey.modules)
     if (f.kind == ModuleKind::kWheel) wheel_motion = std::max(wheel_motion, f.traits.motion_time);
   // The clocks are judged against a module whose data, as the manifest times them, cover
-  // its static period (a body first): the manifest's own times are in that clock.
+  // its static period (a body first): the manifest's own times are in that clock. A static
+  // period is often written from a round time before the first record (a simulated one from
+  // the start, its first record 1 / rate later): data that leave a little of it out at either
+  // end (a fifth of it, at most 1 s) still cover it.
+  const double slack = std::min(1.0, 0.2 * std::max(0.0, man.static_end - man.static_start));
+  auto covers_static = [&](const ModuleFinding& f) {
+    return f.input_start <= man.static_start + slack && f.input_end >= man.static_end - slack;
+  };
   const ModuleFinding* ref = nullptr;
   for (int pass = 0; pass < 2 && !ref; ++pass)
     for (const auto& f : survey.modules)
-      if ((pass == 1 || f.kind == ModuleKind::kBody) && f.clock.found && f.input_start <= man.static_start &&
-          f.input_end >= man.static_end) {
+      if ((pass == 1 || f.kind == ModuleKind::kBody) && f.clock.found && covers_static(f)) {
         ref = &f;
         break;
       }
