@@ -84,9 +84,14 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
       }
   const double ref_offset = ref ? ref->clock.offset : 0.0;
   const double ref_sigma = ref ? ref->clock.sigma : 0.0;
-  // The run's span as the manifest times it: from the static period to the latest end.
+  // The run's span as the manifest times it: from the static period to the latest end of the
+  // modules on the run's clock, those whose data cover the static period (all of them if none
+  // does): a module whose clock is off must not stretch the run and have the others blamed.
   double run_end = -1e300;
-  for (const auto& f : survey.modules) run_end = std::max(run_end, f.input_end);
+  for (const auto& f : survey.modules)
+    if (covers_static(f)) run_end = std::max(run_end, f.input_end);
+  if (run_end == -1e300)
+    for (const auto& f : survey.modules) run_end = std::max(run_end, f.input_end);
   const double run_start = man.static_start;
 
   for (std::size_t i = 0; i < modules.size(); ++i) {
