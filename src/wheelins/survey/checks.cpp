@@ -12,10 +12,15 @@ namespace {
 
 using io_detail::format_double;
 
+/// printf of up to three numbers, as long as it takes (the steering warning alone is over
+/// 200 characters).
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
+  const int n = std::snprintf(nullptr, 0, f, a, b, c);
+  if (n <= 0) return {};
+  std::string out(static_cast<std::size_t>(n) + 1, '\0');
+  std::snprintf(out.data(), out.size(), f, a, b, c);
+  out.resize(static_cast<std::size_t>(n));
+  return out;
 }
 
 std::string axis_name(const Vec3& u) {
@@ -63,20 +68,31 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
   for (const auto& f : survey.modules)
     if (f.kind == ModuleKind::kWheel) wheel_motion = std::max(wheel_motion, f.traits.motion_time);
   // The clocks are judged against a module whose data, as the manifest times them, cover
-  // its static period (a body first): the manifest's own times are in that clock.
+  // its static period (a body first): the manifest's own times are in that clock. A static
+  // period is often written from a round time before the first record (a simulated one from
+  // the start, its first record 1 / rate later): data that leave a little of it out at either
+  // end (a fifth of it, at most 1 s) still cover it.
+  const double slack = std::min(1.0, 0.2 * std::max(0.0, man.static_end - man.static_start));
+  auto covers_static = [&](const ModuleFinding& f) {
+    return f.input_start <= man.static_start + slack && f.input_end >= man.static_end - slack;
+  };
   const ModuleFinding* ref = nullptr;
   for (int pass = 0; pass < 2 && !ref; ++pass)
     for (const auto& f : survey.modules)
-      if ((pass == 1 || f.kind == ModuleKind::kBody) && f.clock.found && f.input_start <= man.static_start &&
-          f.input_end >= man.static_end) {
+      if ((pass == 1 || f.kind == ModuleKind::kBody) && f.clock.found && covers_static(f)) {
         ref = &f;
         break;
       }
   const double ref_offset = ref ? ref->clock.offset : 0.0;
   const double ref_sigma = ref ? ref->clock.sigma : 0.0;
-  // The run's span as the manifest times it: from the static period to the latest end.
+  // The run's span as the manifest times it: from the static period to the latest end of the
+  // modules on the run's clock, those whose data cover the static period (all of them if none
+  // does): a module whose clock is off must not stretch the run and have the others blamed.
   double run_end = -1e300;
-  for (const auto& f : survey.modules) run_end = std::max(run_end, f.input_end);
+  for (const auto& f : survey.modules)
+    if (covers_static(f)) run_end = std::max(run_end, f.input_end);
+  if (run_end == -1e300)
+    for (const auto& f : survey.modules) run_end = std::max(run_end, f.input_end);
   const double run_start = man.static_start;
 
   for (std::size_t i = 0; i < modules.size(); ++i) {
