@@ -187,7 +187,7 @@ TEST_F(Hardening, NonFiniteSampleIsAFaultLikeOneBeyondTheRange) {
   EXPECT_HAS(read_all(d / "out" / "faults.csv"), "samples_beyond_range,2");
   r.nav.faults.enabled = false;
   r.output_dir = d / "out2";
-  EXPECT_HAS(error_of([&] { run_navigation(r); }), "record 7000 (0-based), column 5 (accel_x): value is NaN");
+  EXPECT_HAS(error_of([&] { run_navigation(r); }), "record 7000 (0-based), column 5 (accel_y): value is NaN");
   EXPECT_FALSE(fs::exists(d / "out2"));
 }
 

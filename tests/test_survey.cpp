@@ -834,10 +834,7 @@ TEST_F(Survey, VendorTablesImportWithAReferenceTrack) {
                                        "' --out '" + (d / "dataset").string() + "'", d);
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   const Manifest m = manifest(d / "dataset");
-  if (!m.truth_file)
-    GTEST_SKIP() << "known defect: `wheelins import TABLES --truth TRACK` accepts the track and ignores it "
-                    "(run/table_dataset.cpp never reads it: no truth file, no truth_time_offset_s, no start "
-                    "position in the drafted manifest)";
+  ASSERT_TRUE(m.truth_file.has_value()) << "the import drafted no truth";
   // The track's clock against the wheels' (the slip makes the wheels lead by some 45 ms).
   EXPECT_TRUE(fs::exists(m.resolve(*m.truth_file)));
   EXPECT_NEAR(m.truth_time_offset, -sim_->module(kBody).time_offset, 0.1);
