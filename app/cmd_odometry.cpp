@@ -21,6 +21,7 @@ namespace fs = std::filesystem;
 struct Options {
   std::string manifest, wheels, gyro, out;
   std::optional<double> align_start;
+  std::string antenna;
   bool force = false;
 };
 
@@ -69,7 +70,7 @@ int run(const Options& o) {
   std::unique_ptr<eval::RunEvaluation> evaluation;
   if (m.truth_file)
     evaluation = std::make_unique<eval::RunEvaluation>(m.resolve(*m.truth_file), m.origin,
-                                                       run_evaluation_options(m, o.align_start));
+                                                       run_evaluation_options(m, o.align_start, o.antenna));
   req.on_record = [&](const TrajectoryRecord& r) {
     for (auto& w : writers) w->write(r);
     if (evaluation) evaluation->add(r);
@@ -100,6 +101,7 @@ const bool registered = cli::register_command(
       sub.add_option("--gyro", o->gyro, "body module for the heading (default: the first body; none: the wheels' "
                                         "speed difference)");
       sub.add_option("--out,-o", o->out, "output directory (trajectory.csv, trajectory.tum); default: none");
+      sub.add_option("--antenna", o->antenna, "evaluation: the truth's antenna X,Y,Z in the vehicle frame [m]");
       sub.add_option("--align-start", o->align_start,
                      "evaluation: align the first METRES of travel onto the truth (default as `run`)");
       sub.add_flag("--force,-f", o->force, "overwrite an earlier output directory");

@@ -47,6 +47,7 @@ struct RunArgs {
   bool force = false;
   bool quiet = false;
   std::optional<double> duration, output_interval, covariance_interval, align_start;
+  std::string antenna;
 };
 
 /// A command-line number in its range [lo, hi] (NaN, infinities and 1e400 fail too).
@@ -119,7 +120,7 @@ int run(const RunArgs& a) {
   if (evaluate) {
     evaluation = std::make_unique<eval::RunEvaluation>(req.manifest.resolve(*req.manifest.truth_file),
                                                        req.manifest.origin,
-                                                       run_evaluation_options(req.manifest, a.align_start));
+                                                       run_evaluation_options(req.manifest, a.align_start, a.antenna));
     req.on_record = [&](const TrajectoryRecord& r) { evaluation->add(r); };
   }
 
@@ -206,6 +207,9 @@ const bool registered = cli::register_command(
                    "Use every sample and module as it comes (no outage, saturation, slip or "
                    "fault isolation)");
       sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
+      sub.add_option("--antenna", a->antenna,
+                     "Evaluation: the truth's antenna X,Y,Z in the vehicle frame [m] (default: the manifest's "
+                     "vehicle.antenna_v_m)");
       sub.add_option("--align-start", a->align_start,
                      "Evaluation: align the trajectory's first METRES of travel onto the truth's (default: 100 "
                      "when the manifest has no initial heading, else 0 = off)");

@@ -33,11 +33,18 @@ for t in "${trials[@]}"; do
       "$(awk '/^  heading RMSE /{print $3}' <<< "$text")"
   }
   m="$out/$t-x/manifest.yaml"
-  row "single (left rear)" "$bin" run -m "$m" -c single -o "$out/$t-x/single" -q --formats tum
-  row "single (right rear)" "$bin" run -m "$m" -c single-right -o "$out/$t-x/single-right" -q --formats tum
-  row "dual (rear pair)" "$bin" run -m "$m" -c dual-wheel -o "$out/$t-x/dual" -q --formats tum
-  row "body/wheel" "$bin" run -m "$m" -c body-wheel -o "$out/$t-x/body-wheel" -q --formats tum
-  row "triple" "$bin" run -m "$m" -c triple -o "$out/$t-x/triple" -q --formats tum
-  row "triple centralized" "$bin" run -m "$m" -c triple --centralized -o "$out/$t-x/triple-c" -q --formats tum
-  row "naive dead reckoning" "$bin" odometry -m "$m"
+  # The reference's antenna (where its positions are of) from this trial's own calibration,
+  # else the other's (one receiver on one car): it places the truth for scoring only; the
+  # navigation does not use it.
+  antenna=$(sed -n 's/.*antenna_v_m: \[\([^]]*\)\].*/\1/p' "$out/$t/calibrated.yaml" | tr -d ' ')
+  [ -n "$antenna" ] || antenna=$(sed -n 's/.*antenna_v_m: \[\([^]]*\)\].*/\1/p' "$out/$other/calibrated.yaml" | tr -d ' ')
+  ant=()
+  [ -n "$antenna" ] && ant=(--antenna "$antenna")
+  row "single (left rear)" "$bin" run -m "$m" -c single -o "$out/$t-x/single" -q --formats tum "${ant[@]}"
+  row "single (right rear)" "$bin" run -m "$m" -c single-right -o "$out/$t-x/single-right" -q --formats tum "${ant[@]}"
+  row "dual (rear pair)" "$bin" run -m "$m" -c dual-wheel -o "$out/$t-x/dual" -q --formats tum "${ant[@]}"
+  row "body/wheel" "$bin" run -m "$m" -c body-wheel -o "$out/$t-x/body-wheel" -q --formats tum "${ant[@]}"
+  row "triple" "$bin" run -m "$m" -c triple -o "$out/$t-x/triple" -q --formats tum "${ant[@]}"
+  row "triple centralized" "$bin" run -m "$m" -c triple --centralized -o "$out/$t-x/triple-c" -q --formats tum "${ant[@]}"
+  row "naive dead reckoning" "$bin" odometry -m "$m" "${ant[@]}"
 done

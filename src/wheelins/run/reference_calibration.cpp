@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/io/truth.hpp"
@@ -66,6 +67,7 @@ Fit2 ls2(const std::vector<double>& v, const std::vector<double>& x, const std::
 
 
 using survey::Signal;
+using eval::Vec2;
 
 /// The least-squares scale k of v_ref(t) = k * x(t) + c * yaw(t) over the epochs after `from`
 /// faster than `min_speed` (both sides smoothed over 1 s; a second pass without residuals
@@ -150,6 +152,72 @@ Signal wheel_ins_speed(const Manifest& m, const std::string& module) {
   };
   run_navigation(req);
   return s;
+}
+
+/// The antenna l (forward, right) from velocities, over the whole drive: the reference
+/// moves as the antenna does, v_ref = v_o + psi_dot R(psi) S l (S turns by 90 deg), so in
+/// turns its velocity departs from the dead reckoning's reference point's by an amount linear
+/// in l -- and velocities carry no accumulated drift, unlike positions. The dead reckoning's
+/// velocity and heading are turned by `yaw` (its start alignment) onto the reference's frame.
+/// Epochs turning faster than 0.05 rad/s at over 1 m/s; 1 sigma from the residuals, counted
+/// over the turns' correlation time (one second's epochs as one).
+struct AntennaFit {
+  bool found = false;
+  Vec2 antenna = Vec2::Zero(), sigma = Vec2::Zero();
+};
+
+AntennaFit fit_antenna(const eval::PlanarTrack& ref, const eval::PlanarTrack& traj, double yaw) {
+  AntennaFit out;
+  auto rot2 = [](double a) {
+    Eigen::Matrix2d R;
+    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+    return R;
+  };
+  Eigen::Matrix2d S;
+  S << 0.0, -1.0, 1.0, 0.0;
+  const Eigen::Matrix2d Ry = rot2(yaw);
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  std::vector<std::pair<Eigen::Matrix2d, Vec2>> rows;
+  std::vector<double> times;
+  for (std::size_t k = 1; k + 1 < ref.t.size(); ++k) {
+    const double dt = ref.t[k + 1] - ref.t[k - 1];
+    if (!(dt > 0.0 && dt < 2.0)) continue;
+    const Vec2 v_ref = (ref.p_ne[k + 1] - ref.p_ne[k - 1]) / dt;
+    const double t = ref.t[k];
+    const auto it = std::lower_bound(traj.t.begin(), traj.t.end(), t);
+    if (it == traj.t.begin() || it == traj.t.end()) continue;
+    const std::size_t j = static_cast<std::size_t>(it - traj.t.begin());
+    // The dead reckoning over the same interval: its mean velocity and its turn rate.
+    const auto at = [&](double tt) {
+      const auto i2 = std::lower_bound(traj.t.begin(), traj.t.end(), tt);
+      return std::min<std::size_t>(static_cast<std::size_t>(i2 - traj.t.begin()), traj.t.size() - 1);
+    };
+    const std::size_t a0 = at(ref.t[k - 1]), a1 = at(ref.t[k + 1]);
+    if (a1 <= a0) continue;
+    const double span = traj.t[a1] - traj.t[a0];
+    if (!(span > 0.5 * dt)) continue;
+    const Vec2 v_o = Ry * (traj.p_ne[a1] - traj.p_ne[a0]) / span;
+    const double psi_dot = wrap_pi(traj.heading[a1] - traj.heading[a0]) / span;
+    const double psi = traj.heading[j] + yaw;
+    if (std::abs(psi_dot) < 0.05 || v_o.norm() < 1.0) continue;
+    const Eigen::Matrix2d J = psi_dot * rot2(psi) * S;
+    rows.push_back({J, v_ref - v_o});
+    times.push_back(t);
+    A += J.transpose() * J;
+    b += J.transpose() * (v_ref - v_o);
+  }
+  if (rows.size() < 20 || std::abs(A.determinant()) < 1e-9) return out;
+  out.antenna = A.ldlt().solve(b);
+  double ss = 0.0;
+  for (const auto& r : rows) ss += (r.second - r.first * out.antenna).squaredNorm();
+  const double span_turning = static_cast<double>(rows.size()) * (times.size() > 1 ? (times.back() - times.front()) / static_cast<double>(times.size() - 1) : 0.2);
+  const double per_second = std::max(1.0, static_cast<double>(rows.size()) / std::max(1.0, span_turning));
+  const double sigma2 = ss / std::max(1.0, 2.0 * static_cast<double>(rows.size()) - 2.0) * per_second;
+  const Eigen::Matrix2d P = A.inverse() * sigma2;
+  out.sigma = Vec2(std::sqrt(P(0, 0)), std::sqrt(P(1, 1)));
+  out.found = true;
+  return out;
 }
 
 }  // namespace
@@ -311,9 +379,15 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     run_navigation(req);
     eval::StartAlignmentOptions ao;
     ao.length = o.align_length;
-    ao.estimate_antenna = o.estimate_antenna;
+    ao.estimate_antenna = false;
     out.alignment = eval::fit_start_alignment(ref, traj, ao);
-    const eval::StartAlignment& a = out.alignment;
+    eval::StartAlignment a = out.alignment;
+    if (a.found && o.estimate_antenna) {
+      const AntennaFit af = fit_antenna(ref, traj, a.yaw);
+      a.antenna = af.antenna;
+      a.antenna_sigma = af.sigma;
+      if (!af.found) a.antenna_sigma = Vec2::Constant(std::numeric_limits<double>::infinity());
+    }
     if (a.found) {
       out.initial_heading = CalibratedValue{a.yaw, a.yaw_sigma, a.yaw_sigma < 5.0 * kDeg};
       if (o.estimate_antenna) {
