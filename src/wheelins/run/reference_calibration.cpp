@@ -398,6 +398,17 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
         const bool sharp = a.antenna_sigma.maxCoeff() < o.max_antenna_sigma;
         out.antenna_forward = CalibratedValue{a.antenna.x(), a.antenna_sigma.x(), on_vehicle && sharp};
         out.antenna_right = CalibratedValue{a.antenna.y(), a.antenna_sigma.y(), on_vehicle && sharp};
+        // The start again with the antenna where it is (the heading no longer absorbs it).
+        if (on_vehicle && sharp) {
+          ao.antenna = a.antenna;
+          const eval::StartAlignment again = eval::fit_start_alignment(ref, traj, ao);
+          if (again.found) {
+            out.alignment = again;
+            out.alignment.antenna = a.antenna;
+            out.alignment.antenna_sigma = a.antenna_sigma;
+            out.initial_heading = CalibratedValue{again.yaw, again.yaw_sigma, again.yaw_sigma < 5.0 * kDeg};
+          }
+        }
         if (!on_vehicle || !sharp)
           out.notes.push_back(fmt("the antenna (forward %.2f +- %.2f m, right %.2f +- %.2f m) is not determined by this drive",
                                   a.antenna.x(), a.antenna_sigma.x(), a.antenna.y(), a.antenna_sigma.y()) +
