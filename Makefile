@@ -26,7 +26,9 @@ build-cli: configure
 demo: build-cli
 	@scripts/demo.sh $(WHEELINS) $(DEMO_DIR)
 
-test: build
+# Everything the tests run (the CLI, the test binary, the Python module), not the benchmarks.
+test: configure
+	@cmake --build $(BUILD) -j$(JOBS) --target wheelins wheelins_tests wheelins_python
 	@ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
 
 bench: build
