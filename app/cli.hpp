@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace wheelins::cli {
 
@@ -11,6 +12,9 @@ namespace wheelins::cli {
 using Runner = std::function<int()>;
 /// Declares a subcommand's options on `sub` and returns what runs it.
 using Setup = std::function<Runner(CLI::App& sub)>;
+
+/// "a,b,,c" -> {a, b, c}: a comma-separated list, empty items dropped.
+std::vector<std::string> split_list(const std::string& text);
 
 /// Called from a static object in each cmd_*.cpp; `order` sorts the --help listing.
 bool register_command(int order, const std::string& name, const std::string& description,

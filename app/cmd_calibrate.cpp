@@ -33,14 +33,6 @@ struct Options {
   bool quiet = false;
 };
 
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 bool same_file(const fs::path& a, const fs::path& b) {
   std::error_code ec;
@@ -65,7 +57,7 @@ int run(const Options& o) {
   check_output_target(report, o.force);
 
   const Manifest m = load_manifest(in);
-  std::vector<std::string> modules = split_list(o.modules);
+  std::vector<std::string> modules = cli::split_list(o.modules);
   if (modules.empty()) {
     for (const auto& s : m.modules) modules.push_back(s.name);
   } else {

@@ -25,14 +25,6 @@ struct Options {
   bool force = false;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 int run(const Options& o) {
   const fs::path in = fs::is_directory(o.manifest) ? fs::path(o.manifest) / "manifest.yaml" : fs::path(o.manifest);
@@ -40,7 +32,7 @@ int run(const Options& o) {
   req.manifest = load_manifest(in);
   const Manifest& m = req.manifest;
   // The rear pair (the dual-wheel configuration's wheels), else one wheel; the first body.
-  req.wheels = split(o.wheels);
+  req.wheels = cli::split_list(o.wheels);
   if (req.wheels.empty()) {
     try {
       req.wheels = configuration_modules(m, "dual-wheel", {});

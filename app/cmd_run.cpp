@@ -17,14 +17,6 @@
 namespace {
 using namespace wheelins;
 
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 struct RunArgs {
   std::string config_file;
@@ -82,15 +74,15 @@ int run(const RunArgs& a) {
     cfg.configuration = a.configuration;
     cfg.modules.clear();  // the command line's choice over the config file's modules
   }
-  if (!a.chips.empty()) cfg.chips = split_list(a.chips);
+  if (!a.chips.empty()) cfg.chips = cli::split_list(a.chips);
   if (!a.modules.empty()) {
-    cfg.modules = split_list(a.modules);
+    cfg.modules = cli::split_list(a.modules);
     if (cfg.modules.empty()) throw InputError("--modules '" + a.modules + "': no module named");
   }
   if (!a.out.empty()) cfg.output_dir = a.out;
   if (!a.formats.empty()) {
     cfg.formats.clear();
-    for (const auto& f : split_list(a.formats)) cfg.formats.push_back(trajectory_format_from_name(f));
+    for (const auto& f : cli::split_list(a.formats)) cfg.formats.push_back(trajectory_format_from_name(f));
   }
   if (!a.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(a.speed);
   if (!a.yaw.empty()) cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(a.yaw);

@@ -28,6 +28,19 @@ bool register_command(int order, const std::string& name, const std::string& des
   registry().push_back({order, name, description, std::move(setup)});
   return true;
 }
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t k = text.find(',', start);
+    std::string item = text.substr(start, k == std::string::npos ? std::string::npos : k - start);
+    if (!item.empty()) out.push_back(std::move(item));
+    if (k == std::string::npos) break;
+    start = k + 1;
+  }
+  return out;
+}
+
 }  // namespace wheelins::cli
 
 namespace {

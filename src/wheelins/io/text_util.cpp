@@ -170,5 +170,29 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
   return prev[b.size()];
 }
 
+void split_fields(std::string_view line, char sep, std::vector<std::string_view>& out) {
+  out.clear();
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  if (sep == ' ') {
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && blank(line[i])) ++i;
+      if (i >= line.size()) break;
+      std::size_t j = i;
+      while (j < line.size() && !blank(line[j])) ++j;
+      out.push_back(line.substr(i, j - i));
+      i = j;
+    }
+    return;
+  }
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t k = line.find(sep, start);
+    out.push_back(line.substr(start, k == std::string_view::npos ? std::string_view::npos : k - start));
+    if (k == std::string_view::npos) break;
+    start = k + 1;
+  }
+}
+
 }  // namespace io_detail
 }  // namespace wheelins

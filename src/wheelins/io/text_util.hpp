@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace wheelins::io_detail {
 
@@ -55,6 +56,10 @@ bool bounded_getline(std::istream& in, std::string& line, std::size_t max_len,
 /// A temporary name beside `file` for writing it, unique to this process and call
 /// (`file.partial-PID-N`): two writers of one file never share (and truncate) a temporary.
 std::filesystem::path unique_partial(const std::filesystem::path& file);
+
+/// The fields of a line separated by `sep`; ' ' means runs of blanks (spaces, tabs, CRs),
+/// where empty fields do not arise. Views into `line`.
+void split_fields(std::string_view line, char sep, std::vector<std::string_view>& out);
 
 /// Levenshtein distance (for "did you mean" suggestions).
 std::size_t edit_distance(std::string_view a, std::string_view b);

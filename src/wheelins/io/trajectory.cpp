@@ -283,27 +283,7 @@ bool parse_double(std::string_view s, double& v) {
 }
 
 void split(std::string_view line, char sep, std::vector<std::string_view>& out) {
-  out.clear();
-  if (sep == ' ') {  // any run of blanks
-    std::size_t i = 0;
-    while (i < line.size()) {
-      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-      if (i >= line.size()) break;
-      std::size_t j = i;
-      while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
-      out.push_back(line.substr(i, j - i));
-      i = j;
-    }
-    return;
-  }
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t k = line.find(sep, start);
-    out.push_back(line.substr(start, k == std::string_view::npos ? std::string_view::npos
-                                                                 : k - start));
-    if (k == std::string_view::npos) break;
-    start = k + 1;
-  }
+  io_detail::split_fields(line, sep, out);
 }
 
 bool is_comment_or_blank(std::string_view line) {

@@ -255,41 +255,20 @@ TruthWriter::TruthWriter(const std::filesystem::path& file, TruthLayout layout, 
 TruthWriter::~TruthWriter() = default;
 
 void TruthWriter::write(const TruthRecord& rec) {
-  if (layout_ == TruthLayout::kPos5) {
-    const double row[kCols5] = {rec.t, rec.lla.lat / kDeg, rec.lla.lon / kDeg, rec.lla.h, 0.0};
-    for (double v : row)
-      if (!std::isfinite(v))
-        throw InputError(where(file_, rows_) + "cannot write a non-finite truth value");
-    if (!lat_lon_ok(row[1], row[2]))
-      throw InputError(where(file_, rows_) + "latitude/longitude out of range");
-    if (rows_ > 0 && !(rec.t > last_t_))
-      throw InputError(where(file_, rows_) + "time " + num(rec.t) +
-                       " s does not increase (previous record: " + num(last_t_) + " s)");
-    out_->write(row);
-    last_t_ = rec.t;
-    ++rows_;
-    return;
-  }
-  const double row[kCols11] = {gps_week_,
-                               rec.t,
-                               rec.lla.lat / kDeg,
-                               rec.lla.lon / kDeg,
-                               rec.lla.h,
-                               rec.v_ned.x(),
-                               rec.v_ned.y(),
-                               rec.v_ned.z(),
-                               rec.rpy.x() / kDeg,
-                               rec.rpy.y() / kDeg,
-                               rec.rpy.z() / kDeg};
-  for (double v : row)
-    if (!std::isfinite(v))
-      throw InputError(where(file_, rows_) + "cannot write a non-finite truth value");
-  if (!lat_lon_ok(row[2], row[3]))
-    throw InputError(where(file_, rows_) + "latitude/longitude out of range");
+  const double row11[kCols11] = {gps_week_,           rec.t,         rec.lla.lat / kDeg, rec.lla.lon / kDeg,
+                                 rec.lla.h,           rec.v_ned.x(), rec.v_ned.y(),      rec.v_ned.z(),
+                                 rec.rpy.x() / kDeg,  rec.rpy.y() / kDeg, rec.rpy.z() / kDeg};
+  const double row5[kCols5] = {rec.t, rec.lla.lat / kDeg, rec.lla.lon / kDeg, rec.lla.h, 0.0};
+  const bool pos5 = layout_ == TruthLayout::kPos5;
+  const double* row = pos5 ? row5 : row11;
+  for (int i = 0; i < (pos5 ? kCols5 : kCols11); ++i)
+    if (!std::isfinite(row[i])) throw InputError(where(file_, rows_) + "cannot write a non-finite truth value");
+  if (!lat_lon_ok(row5[1], row5[2])) throw InputError(where(file_, rows_) + "latitude/longitude out of range");
   if (rows_ > 0 && !(rec.t > last_t_))
-    throw InputError(where(file_, rows_) + "time " + num(rec.t) +
-                     " s does not increase (previous record: " + num(last_t_) + " s)");
-  out_->write(row);
+    throw InputError(where(file_, rows_) + "time " + num(rec.t) + " s does not increase (previous record: " +
+                     num(last_t_) + " s)");
+  if (pos5) out_->write(row5);
+  else out_->write(row11);
   last_t_ = rec.t;
   ++rows_;
 }

@@ -40,28 +40,12 @@ bool is_comment_or_blank(std::string_view line) {
   return line.empty() || line.front() == '#';
 }
 
-// Splits at `delim`; ' ' means runs of blanks (spaces and tabs).
+// Splits at `delim` (' ': runs of blanks), each field trimmed.
 void split_fields(std::string_view line, char delim, std::vector<std::string>& out) {
+  thread_local std::vector<std::string_view> views;
+  io_detail::split_fields(line, delim, views);
   out.clear();
-  if (delim == ' ') {
-    std::size_t i = 0;
-    while (i < line.size()) {
-      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-      if (i >= line.size()) break;
-      std::size_t j = i;
-      while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
-      out.emplace_back(trim(line.substr(i, j - i)));
-      i = j;
-    }
-    return;
-  }
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t k = line.find(delim, start);
-    out.emplace_back(trim(line.substr(start, k == std::string_view::npos ? std::string_view::npos : k - start)));
-    if (k == std::string_view::npos) break;
-    start = k + 1;
-  }
+  for (std::string_view v : views) out.emplace_back(trim(v));
 }
 
 char delimiter_of(std::string_view line) {
