@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "dataset_test_util.hpp"
 #include "io_test_util.hpp"
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/manifest.hpp"
@@ -37,19 +38,18 @@
 namespace {
 using namespace wheelins;
 using iotest::error_of;
+using dstest::CmdResult;
+using dstest::edit_module_text;
+using dstest::number_after;
+using dstest::read_doubles;
+using dstest::wheelins_cli;
+using dstest::write_table;
 namespace fs = std::filesystem;
 
 const std::vector<std::string> kModules{"left-C1", "right-C1", "body-C1"};
 constexpr int kLeft = 0, kRight = 1, kBody = 2;  // also the simulator's group indices
 
 // ------------------------------------------------------------------ IMU files and messages
-
-std::vector<double> read_doubles(const fs::path& file) {
-  const std::string b = iotest::read_text_file(file);
-  std::vector<double> v(b.size() / sizeof(double));
-  std::memcpy(v.data(), b.data(), v.size() * sizeof(double));
-  return v;
-}
 
 /// Rewrites an IMU file (rows of t, gyro xyz, accel xyz) through `edit` on each row.
 void edit_rows(const fs::path& file, const std::function<void(double*)>& edit) {
@@ -81,28 +81,6 @@ std::string line_with(const std::string& text, const std::string& needle) {
   if (at == std::string::npos) return "";
   const std::size_t from = text.rfind('\n', at), to = text.find('\n', at);
   return text.substr(from == std::string::npos ? 0 : from + 1, to == std::string::npos ? std::string::npos : to - from - 1);
-}
-
-/// The number after `key` in `text` (NaN if there is none).
-double number_after(const std::string& text, const std::string& key) {
-  const std::size_t at = text.find(key);
-  if (at == std::string::npos) return std::nan("");
-  const char* p = text.c_str() + at + key.size();
-  char* end = nullptr;
-  const double v = std::strtod(p, &end);
-  return end == p ? std::nan("") : v;
-}
-
-/// Replaces the first `from` after module `name`'s entry in a manifest's text by `to`.
-void edit_module_text(const fs::path& manifest_file, const std::string& name, const std::string& from,
-                      const std::string& to) {
-  std::string text = iotest::read_text_file(manifest_file);
-  const std::size_t entry = text.find("name: \"" + name + "\"");
-  ASSERT_NE(entry, std::string::npos) << name;
-  const std::size_t at = text.find(from, entry);
-  ASSERT_NE(at, std::string::npos) << from;
-  text.replace(at, from.size(), to);
-  iotest::write_text(manifest_file, text);
 }
 
 double angle_deg(const Vec3& a, const Vec3& b) {
@@ -695,34 +673,6 @@ TEST_F(Survey, ReferenceTrackInAnotherTimeUnitIsFitted) {
 }
 
 // ------------------------------------------------------------------ 11. tables imported
-
-struct CmdResult {
-  int code = -1;
-  std::string out, err;
-};
-
-CmdResult wheelins_cli(const std::string& args, const fs::path& scratch) {
-  const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-  const std::string cmd = std::string("'") + WHEELINS_BINARY + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, iotest::read_text_file(out), iotest::read_text_file(err)};
-}
-
-/// An IMU file as a vendor's CSV table: `t,gx,gy,gz,ax,ay,az`, the gyro in deg/s (a units
-/// line says so), the axes turned by R (v' = R v), `shift` added to the times.
-void write_table(const fs::path& bin, const fs::path& csv, const Mat3& R, double shift) {
-  const std::vector<double> v = read_doubles(bin);
-  std::string text = "# units: s, deg/s, m/s^2\nt,gx,gy,gz,ax,ay,az\n";
-  text.reserve(v.size() / 7 * 140);
-  char line[400];
-  for (std::size_t k = 0; k + 7 <= v.size(); k += 7) {
-    const Vec3 g = R * Vec3(v[k + 1], v[k + 2], v[k + 3]) / kDeg, a = R * Vec3(v[k + 4], v[k + 5], v[k + 6]);
-    std::snprintf(line, sizeof line, "%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", v[k] + shift, g.x(), g.y(), g.z(),
-                  a.x(), a.y(), a.z());
-    text += line;
-  }
-  iotest::write_text(csv, text);
-}
 
 /// `records`' horizontal positions at time t (linear between records).
 Vec3 position_at(const std::vector<TrajectoryRecord>& records, double t) {

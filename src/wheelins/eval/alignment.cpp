@@ -69,8 +69,13 @@ Vec2 apply_alignment(const StartAlignment& a, const Vec2& p) { return a.shift + 
 StartAlignment fit_start_alignment(const PlanarTrack& ref, const PlanarTrack& tr, const StartAlignmentOptions& o) {
   StartAlignment out;
   if (tr.heading.size() != tr.t.size() || tr.t.size() < 2 || ref.t.size() < 2) return out;
+  // The reference epochs at least kMinSpacing apart: a denser reference (a 200 Hz INS
+  // truth) adds epochs whose residuals are the same, and the lag-1 correlation below,
+  // clamped at 0.99, would count them as independent -- the sigmas would shrink with the
+  // reference's rate (by sqrt(20) from 10 Hz to 200 Hz for the same track).
+  constexpr double kMinSpacing = 0.1 - 1e-6;
   std::vector<Pair> pairs;
-  double travelled = 0.0;
+  double travelled = 0.0, last_used = -std::numeric_limits<double>::infinity();
   bool started = false;
   Vec2 prev = Vec2::Zero();
   for (std::size_t k = 0; k < ref.t.size(); ++k) {
@@ -80,6 +85,8 @@ StartAlignment fit_start_alignment(const PlanarTrack& ref, const PlanarTrack& tr
     prev = ref.p_ne[k];
     started = true;
     if (o.length > 0.0 && travelled > o.length) break;
+    if (ref.t[k] < last_used + kMinSpacing) continue;
+    last_used = ref.t[k];
     p.g = ref.p_ne[k];
     pairs.push_back(p);
     out.t_end = ref.t[k];

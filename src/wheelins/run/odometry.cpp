@@ -48,24 +48,15 @@ OdometryResult run_wheel_odometry(const OdometryRequest& r) {
   double psi = m.initial_heading, t_prev = 0.0, next_out = -1e300;
   Vec3 p = Vec3::Zero();
   bool started = false;
-  std::size_t k = 0;
-  ImuSample s;
-  while (merger.next(k, s)) {
-    const Vec3 w = s.dtheta / s.dt;
-    rate[k] = w;
-    seen[k] = true;
-    if (s.t <= m.static_end) {
-      if (s.t >= m.static_start) bias_sum[k] += w, bias_n[k] += 1.0;
-      continue;
-    }
-    if (k != 0) continue;  // the first wheel's samples drive the integration
+  auto body_rate = [&](std::size_t i) {
+    const Vec3 b = bias_n[i] > 0.0 ? Vec3(bias_sum[i] / bias_n[i]) : Vec3::Zero();
+    return Vec3(C[i] * (rate[i] - b));
+  };
+  // One step to the first wheel's sample at t, with every module's latest sample up to t.
+  auto step = [&](double t) {
     bool all_seen = true;
     for (bool x : seen) all_seen = all_seen && x;
-    if (!all_seen) continue;
-    auto body_rate = [&](std::size_t i) {
-      const Vec3 b = bias_n[i] > 0.0 ? Vec3(bias_sum[i] / bias_n[i]) : Vec3::Zero();
-      return Vec3(C[i] * (rate[i] - b));
-    };
+    if (!all_seen) return;
     // Speeds of the wheels, the yaw rate (counter-clockwise from above), the speed at o.
     std::vector<double> v(nw);
     for (std::size_t i = 0; i < nw; ++i)
@@ -77,20 +68,20 @@ OdometryResult run_wheel_odometry(const OdometryRequest& r) {
     vo /= static_cast<double>(nw);
     if (!started) {
       started = true;
-      t_prev = s.t;
-      out.t_start = s.t;
+      t_prev = t;
+      out.t_start = t;
     }
-    const double dt = s.t - t_prev;
-    t_prev = s.t;
+    const double dt = t - t_prev;
+    t_prev = t;
     const double psi_mid = psi - 0.5 * yaw_up * dt;
     p += Vec3(std::cos(psi_mid), std::sin(psi_mid), 0.0) * vo * dt;
     psi = wrap_pi(psi - yaw_up * dt);
     out.distance += std::abs(vo) * dt;
-    out.t_end = s.t;
-    if (s.t + 1e-9 < next_out) continue;
-    next_out = s.t + r.output_interval;
+    out.t_end = t;
+    if (t + 1e-9 < next_out) return;
+    next_out = t + r.output_interval;
     TrajectoryRecord rec;
-    rec.t = s.t;
+    rec.t = t;
     rec.p_inN = p;
     rec.lla = frame.geodetic_from_ned(p);
     rec.v_inN = Vec3(std::cos(psi), std::sin(psi), 0.0) * vo;
@@ -98,7 +89,31 @@ OdometryResult run_wheel_odometry(const OdometryRequest& r) {
     rec.p_std = rec.v_std = rec.rpy_std = Vec3::Constant(std::nan(""));
     ++out.records;
     if (r.on_record) r.on_record(rec);
+  };
+  // The first wheel's samples drive the integration; a step is taken once the merged
+  // samples have passed its time (the other modules' samples of the same time come after
+  // it: the merger gives equal times in module order).
+  bool pending = false;
+  double pending_t = 0.0;
+  std::size_t k = 0;
+  ImuSample s;
+  while (merger.next(k, s)) {
+    if (pending && s.t > pending_t) {
+      step(pending_t);
+      pending = false;
+    }
+    rate[k] = s.dtheta / s.dt;
+    seen[k] = true;
+    if (s.t <= m.static_end) {
+      if (s.t >= m.static_start) bias_sum[k] += rate[k], bias_n[k] += 1.0;
+      continue;
+    }
+    if (k == 0) {
+      pending = true;
+      pending_t = s.t;
+    }
   }
+  if (pending) step(pending_t);
   if (!started)
     throw InputError(man + ": the data end before the static period does: nothing to dead-reckon");
   return out;
