@@ -28,7 +28,7 @@ struct Options {
   std::optional<double> duration;
   bool no_faults = false;
   bool reference = false;
-  std::optional<double> align_length;
+  std::optional<double> align_length, min_speed;
   bool force = false;
   bool quiet = false;
 };
@@ -74,6 +74,11 @@ int run(const Options& o) {
     ReferenceCalibrationOptions ro;
     ro.progress = !o.quiet;
     if (o.align_length) ro.align_length = *o.align_length;
+    if (o.min_speed) {
+      if (!(*o.min_speed >= 0.1 && *o.min_speed <= 50.0))
+        throw InputError("--min-speed " + std::to_string(*o.min_speed) + ": must be in [0.1, 50] m/s");
+      ro.min_speed = *o.min_speed;
+    }
     ref = calibrate_against_reference(m, modules, cal, ro, stderr_sink());
     std::cout << reference_calibration_report(*ref);
   }
@@ -119,6 +124,9 @@ const bool registered = cli::register_command(
       sub.add_flag("--reference", o->reference,
                    "also estimate what only the manifest's truth (a GNSS track) shows: each wheel's "
                    "absolute rolling radius, the initial heading and the antenna's position");
+      sub.add_option("--min-speed", o->min_speed,
+                     "m/s: the reference epochs the radii are fitted on are faster (default 1.5; a slow robot "
+                     "needs less)");
       sub.add_option("--align-length", o->align_length,
                      "metres of the reference's travel the initial heading is fitted on (default 300; 0: all)");
       sub.add_flag("--force,-f", o->force, "overwrite existing output files");

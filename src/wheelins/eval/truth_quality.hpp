@@ -32,6 +32,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -114,6 +115,7 @@ class TruthQualityMonitor {
   TruthQualityOptions opt_;
   TruthQualityReport report_;
   std::deque<double> window_;
+  double median_cache_ = std::numeric_limits<double>::quiet_NaN();
   bool have_prev_ = false;
   Fix prev_;                    // the previous record
   bool prev_bad_ = false;       // it was bad

@@ -301,6 +301,72 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     return (1.0 - a) * ref_v[k - 1] + a * ref_v[k];
   };
 
+  // A wheel's speed in turns of its axle (rad/s, forward positive), from the raw rate.
+  auto axle_rate = [&](std::size_t i) {
+    const ModuleSpec& spec = *m.find(modules[i]);
+    const Mat3 C = wheel_sensor_to_body(spec);
+    Signal omega;
+    for (std::size_t k = 0; k < S[i].size(); ++k) {
+      omega.t.push_back(S[i].time(k));
+      omega.x.push_back(-spec.axle_sign * (C * (S[i].gyro[k] - bias[i])).x());
+    }
+    omega.step = S[i].dt;
+    return omega;
+  };
+
+  // The reference's clock, refined: the shift of its times that best fits its speed to an
+  // unsteered wheel's with the yaw term (its antenna's speed departs from the wheels' in
+  // turns, which pulls a plain correlation of the speeds, as the import's); scanned over
+  // +-0.25 s, refined by a parabola; 1 sigma from five parts of the drive.
+  out.truth_time_offset = CalibratedValue{m.truth_time_offset, 0.0, false};
+  for (std::size_t i = 0; i < modules.size(); ++i) {
+    if (sv.modules[i].kind != ModuleKind::kWheel || sv.modules[i].steered || m.find(modules[i])->kind != ModuleKind::kWheel)
+      continue;
+    const Signal omega = axle_rate(i);
+    auto best_shift = [&](double from, double to) {
+      const double step = 0.01;
+      std::vector<double> corr;
+      for (int k = -25; k <= 25; ++k) {
+        const double d = k * step;
+        const auto shifted = [&](double t) { return ref_speed(t - d); };
+        Signal part = omega;
+        std::vector<double> keep_t, keep_x;
+        for (std::size_t q = 0; q < omega.t.size(); ++q)
+          if (omega.t[q] >= from && omega.t[q] <= to) keep_t.push_back(omega.t[q]), keep_x.push_back(omega.x[q]);
+        part.t = keep_t;
+        part.x = keep_x;
+        const SpeedScale f = fit_speed_scale(shifted, part, yaw, m.static_end, o.min_speed);
+        corr.push_back(f.observed ? f.correlation : -1.0);
+      }
+      std::size_t b = 0;
+      for (std::size_t k = 1; k < corr.size(); ++k)
+        if (corr[k] > corr[b]) b = k;
+      if (corr[b] < 0.0 || b == 0 || b + 1 == corr.size()) return std::nan("");
+      const double den = corr[b - 1] - 2.0 * corr[b] + corr[b + 1];
+      const double frac = den < 0.0 ? std::clamp(0.5 * (corr[b - 1] - corr[b + 1]) / den, -0.5, 0.5) : 0.0;
+      return (static_cast<double>(b) - 25.0 + frac) * step;
+    };
+    const double d = best_shift(-1e300, 1e300);
+    if (!std::isfinite(d)) break;
+    std::vector<double> parts;
+    const double t0 = std::max(m.static_end, omega.start()), len = (omega.end() - t0) / 5.0;
+    for (int p = 0; p < 5; ++p) {
+      const double dp = best_shift(t0 + p * len, t0 + (p + 1) * len);
+      if (std::isfinite(dp)) parts.push_back(dp);
+    }
+    double sd = 0.005;
+    if (parts.size() >= 3) {
+      double mean = 0.0, ss = 0.0;
+      for (double x : parts) mean += x;
+      mean /= static_cast<double>(parts.size());
+      for (double x : parts) ss += (x - mean) * (x - mean);
+      sd = std::max(sd, std::sqrt(ss / static_cast<double>(parts.size() - 1) / static_cast<double>(parts.size())));
+    }
+    out.truth_time_offset = CalibratedValue{m.truth_time_offset + d, sd, true};
+    for (double& t : ref.t) t += d;  // everything below on the refined clock
+    break;
+  }
+
   // Each wheel's radius: first from its turn rate, then from the speed its own Wheel-INS
   // gives with that radius (the filter refines the axle gyro's scale factor against gravity,
   // so the radius that makes the filter's speed right is what the run needs).
@@ -311,13 +377,7 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     w.module = spec.name;
     w.manifest_radius = m0.find(spec.name)->wheel_radius;
     w.radius = CalibratedValue{spec.wheel_radius, 0.0, false};
-    const Mat3 C = wheel_sensor_to_body(spec);
-    Signal omega;
-    for (std::size_t k = 0; k < S[i].size(); ++k) {
-      omega.t.push_back(S[i].time(k));
-      omega.x.push_back(-spec.axle_sign * (C * (S[i].gyro[k] - bias[i])).x());
-    }
-    omega.step = S[i].dt;
+    const Signal omega = axle_rate(i);
     const SpeedScale first = fit_speed_scale(ref_speed, omega, yaw, m.static_end, o.min_speed);
     w.epochs = first.epochs;
     w.correlation = first.correlation;
@@ -424,6 +484,7 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
 }
 
 Manifest apply_reference_calibration(Manifest m, const ReferenceCalibration& cal) {
+  if (cal.truth_time_offset.observed) m.truth_time_offset = cal.truth_time_offset.value;
   for (const WheelRadiusFit& w : cal.wheels)
     if (w.radius.observed)
       for (auto& s : m.modules)
@@ -458,6 +519,8 @@ std::string reference_calibration_report(const ReferenceCalibration& c) {
        (c.initial_heading.observed ? fmt("  (dead reckoning of %.0f wheel(s) aligned over %.0f m, residual %.3f m)\n",
                                          static_cast<double>(c.navigation_modules.size()), a.length, a.rms)
                                    : std::string("  not observed\n"));
+  s += fmt("  reference clock  %+.4f +- %.4f s (truth_time_offset_s; the speeds with the turns' term)\n",
+           c.truth_time_offset.value, c.truth_time_offset.std);
   s += fmt("  antenna          forward %.3f +- %.3f m, right %.3f +- %.3f m", c.antenna_forward.value, c.antenna_forward.std,
            c.antenna_right.value, c.antenna_right.std) +
        (c.antenna_forward.observed ? "\n" : "  (not observed)\n");
@@ -474,6 +537,7 @@ std::string reference_calibration_yaml(const ReferenceCalibration& c, const Mani
   for (const WheelRadiusFit& w : c.wheels)
     s += "    " + io_detail::json_quote(w.module) + ":\n      wheel_radius_m: " + val(w.radius, 1.0, w.manifest_radius) +
          "\n      odometry_radius_m: " + val(w.odometry_radius, 1.0, w.manifest_radius) + "\n";
+  s += "  truth_time_offset_s: " + val(c.truth_time_offset, 1.0, m.truth_time_offset) + "\n";
   s += "  initial:\n    heading_deg: " + val(c.initial_heading, 1.0 / kDeg, m.initial_heading) + "\n";
   s += "  vehicle:\n    antenna_forward_m: " + val(c.antenna_forward, 1.0, m.antenna_inV ? m.antenna_inV->x() : 0.0) + "\n";
   s += "    antenna_right_m: " + val(c.antenna_right, 1.0, m.antenna_inV ? m.antenna_inV->y() : 0.0) + "\n";

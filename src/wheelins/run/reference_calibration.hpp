@@ -6,6 +6,9 @@
 //     1 s; a second pass without the residuals beyond 4 MADs; 1 sigma from the scatter of
 //     the same fit on 5 parts of the drive (the standard error of their mean) or the least
 //     squares' own, whichever is larger;
+//   * the reference's clock offset, refined: the shift of its times that best fits its speed
+//     to an unsteered wheel's with the yaw term (the antenna's speed departs from the
+//     wheels' in turns);
 //   * the initial heading and the antenna's horizontal position on the vehicle: a dead
 //     reckoning of the unsteered wheels with the radii, in a local frame, aligned onto the
 //     reference over its first `align_length` metres (eval/alignment.hpp);
@@ -43,6 +46,7 @@ struct WheelRadiusFit {
 struct ReferenceCalibration {
   std::vector<WheelRadiusFit> wheels;
   CalibratedValue initial_heading;        ///< [rad]
+  CalibratedValue truth_time_offset;      ///< [s] the reference's clock, refined
   CalibratedValue antenna_forward, antenna_right;  ///< [m], in the v-frame
   eval::StartAlignment alignment;
   std::vector<std::string> navigation_modules;  ///< the dead reckoning the heading came from

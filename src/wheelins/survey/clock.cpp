@@ -140,6 +140,9 @@ double correlation_at(const Signal& a, const Signal& b, double o, double step, d
   const double from = std::max(a.start(), b.start() + o), to = std::min(a.end(), b.end() + o);
   if (overlap) *overlap = std::max(0.0, to - from);
   if (!(to - from >= min_overlap)) return std::nan("");
+  // At most about 4000 points: the correlation of a long overlap needs no more, and the
+  // searches call this for every lag.
+  step = std::max(step, (to - from) / 4000.0);
   double sx = 0.0, sy = 0.0, sxx = 0.0, syy = 0.0, sxy = 0.0, m = 0.0;
   for (double t = from; t <= to; t += step) {
     const double x = a.at(t), y = b.at(t - o);
@@ -170,7 +173,7 @@ ClockFit fit_clock_offset(const Signal& a, const Signal& b, const ClockOptions& 
     const Signal ak = part(a, from + k * len, from + (k + 1) * len);
     if (ak.t.size() < 10) continue;
     double c = 0.0;
-    const double ok = refine(ak, b, fit.offset, 0.3, fine, 0.5 * len, &c);
+    const double ok = refine(ak, b, fit.offset, 0.2, fine, 0.5 * len, &c);
     if (std::isfinite(c) && c > 0.0) offs.push_back(ok);
   }
   if (offs.size() >= 2) {

@@ -141,12 +141,12 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
   if (n == 0) return out;
   // The wheel all clocks are tied through: the one with the longest data (the others are
   // matched against it), the first listed among equals.
-  std::stable_sort(wheels.begin(), wheels.end(), [&](int a, int b) {
-    // Whole seconds, so that the order is strict and spans alike keep their listed order.
+  std::sort(wheels.begin(), wheels.end(), [&](int a, int b) {
+    // Whole seconds (spans alike keep their listed order: the index breaks ties).
     const auto span = [&](int i) {
       return std::floor(S[static_cast<std::size_t>(i)].t_last - S[static_cast<std::size_t>(i)].t_first);
     };
-    return span(a) > span(b);
+    return span(a) != span(b) ? span(a) > span(b) : a < b;
   });
   const double step = S.front().dt;
   auto signal = [&](std::size_t i, const std::vector<double>& x) { return Signal::of(S[i], x); };
