@@ -77,9 +77,9 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
     return f.input_start <= man.static_start + slack && f.input_end >= man.static_end - slack;
   };
   const ModuleFinding* ref = nullptr;
-  for (int pass = 0; pass < 2 && !ref; ++pass)
+  for (int pass = 0; pass < 3 && !ref; ++pass)
     for (const auto& f : survey.modules)
-      if ((pass == 1 || f.kind == ModuleKind::kBody) && f.clock.found && covers_static(f)) {
+      if ((pass == 2 || (f.kind == ModuleKind::kBody) == (pass == 0)) && (pass == 2 || !f.clock_weak) && f.clock.found && covers_static(f)) {
         ref = &f;
         break;
       }
@@ -124,7 +124,8 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
 
     // Clock and coverage.
     bool clock_reported = false;
-    if (f->clock.found && f != ref && f->clock.correlation >= o.min_clock_correlation) {
+    const bool weak_pair = f->clock_weak || (ref && ref->clock_weak);  // a body tied to the wheels only coarsely
+    if (f->clock.found && f != ref && !weak_pair && f->clock.correlation >= o.min_clock_correlation) {
       const double off = f->clock.offset - ref_offset, sig = std::hypot(f->clock.sigma, ref_sigma);
       const std::string suggestion = format_double(std::round((spec->time_offset + off) * 1e4) / 1e4);
       if (std::abs(off) > o.clock_error && std::abs(off) > 4.0 * sig) {

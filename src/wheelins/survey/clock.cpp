@@ -119,30 +119,12 @@ void Signal::shift(double offset) {
   for (double& v : t) v += offset;
 }
 
-double Signal::at(double time) const {
-  if (t.empty()) return 0.0;
-  if (!(time > t.front())) return x.front();
-  if (time >= t.back()) return x.back();
-  if (step > 0.0) {
-    const double u = (time - t.front()) / step;
-    const std::size_t k = std::min(static_cast<std::size_t>(u), x.size() - 2);
-    const double a = u - static_cast<double>(k);
-    return (1.0 - a) * x[k] + a * x[k + 1];
-  }
-  const auto it = std::upper_bound(t.begin(), t.end(), time);
-  const std::size_t k = static_cast<std::size_t>(it - t.begin());
-  const double a = (time - t[k - 1]) / (t[k] - t[k - 1]);
-  return (1.0 - a) * x[k - 1] + a * x[k];
-}
 
 double correlation_at(const Signal& a, const Signal& b, double o, double step, double min_overlap,
                       double* overlap) {
   const double from = std::max(a.start(), b.start() + o), to = std::min(a.end(), b.end() + o);
   if (overlap) *overlap = std::max(0.0, to - from);
   if (!(to - from >= min_overlap)) return std::nan("");
-  // At most about 4000 points: the correlation of a long overlap needs no more, and the
-  // searches call this for every lag.
-  step = std::max(step, (to - from) / 4000.0);
   double sx = 0.0, sy = 0.0, sxx = 0.0, syy = 0.0, sxy = 0.0, m = 0.0;
   for (double t = from; t <= to; t += step) {
     const double x = a.at(t), y = b.at(t - o);
@@ -173,7 +155,7 @@ ClockFit fit_clock_offset(const Signal& a, const Signal& b, const ClockOptions& 
     const Signal ak = part(a, from + k * len, from + (k + 1) * len);
     if (ak.t.size() < 10) continue;
     double c = 0.0;
-    const double ok = refine(ak, b, fit.offset, 0.2, fine, 0.5 * len, &c);
+    const double ok = refine(ak, b, fit.offset, 0.1, fine, 0.5 * len, &c);
     if (std::isfinite(c) && c > 0.0) offs.push_back(ok);
   }
   if (offs.size() >= 2) {

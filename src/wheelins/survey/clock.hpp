@@ -10,6 +10,7 @@
 // parts of the overlap (the standard error of their mean, at least a tenth of a step).
 #pragma once
 
+#include <algorithm>
 #include <limits>
 #include <vector>
 
@@ -41,11 +42,27 @@ struct Signal {
   /// > 0 when t is evenly spaced by it (at() then needs no search).
   double step = 0.0;
   static Signal of(const Series& s, const std::vector<double>& x);
-  double at(double time) const;  ///< linear interpolation, clamped at the ends
+  double at(double time) const;  ///< linear interpolation, clamped at the ends (inline below: hot)
   void shift(double offset);     ///< adds offset to every time
   double start() const { return t.empty() ? 0.0 : t.front(); }
   double end() const { return t.empty() ? 0.0 : t.back(); }
 };
+
+inline double Signal::at(double time) const {
+  if (t.empty()) return 0.0;
+  if (!(time > t.front())) return x.front();
+  if (time >= t.back()) return x.back();
+  if (step > 0.0) {
+    const double u = (time - t.front()) / step;
+    const std::size_t k = std::min(static_cast<std::size_t>(u), x.size() - 2);
+    const double a = u - static_cast<double>(k);
+    return (1.0 - a) * x[k] + a * x[k + 1];
+  }
+  const auto it = std::upper_bound(t.begin(), t.end(), time);
+  const std::size_t k = static_cast<std::size_t>(it - t.begin());
+  const double a = (time - t[k - 1]) / (t[k] - t[k - 1]);
+  return (1.0 - a) * x[k - 1] + a * x[k];
+}
 
 /// The offset o with a(t) = b(t - o) (see the header).
 ClockFit fit_clock_offset(const Signal& a, const Signal& b, const ClockOptions& options = {});

@@ -210,6 +210,7 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
           if (f.found && f.correlation >= o.min_clock_correlation) {
             best = combine(f, to_w0[j], -1.0);
             basis = "acceleration against " + S[j].module;
+            out.modules[i].clock_weak = true;
           } else {
             best = ClockFit{};
             basis = "not found (no common turning or acceleration)";

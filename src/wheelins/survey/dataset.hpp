@@ -65,6 +65,10 @@ struct ModuleFinding {
   /// input's + this).
   ClockFit clock;
   bool clock_reference = false;
+  /// A body whose clock is tied to the wheels' only by the size of an acceleration (no
+  /// turns): good enough for the survey's own comparisons, too coarse to judge a manifest's
+  /// offsets by (survey/checks.cpp leaves such a body's clock against the wheels' out).
+  bool clock_weak = false;
   std::string clock_basis;  ///< what the clock was fitted on ("spin rate vs IMU4", ...)
   int side = 0;             ///< wheels: +1 right, -1 left, 0 not determined
   double side_evidence = 0.0;
