@@ -14,4 +14,9 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_WERROR=ON \
 cmake --build "$build" -j"$(nproc)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-ctest --test-dir "$build" -j"$(nproc)" --output-on-failure
+# Left out here (they run in the Release suite of `make test`): end-to-end checks of numbers
+# (ideal data add no error, covariances stay positive definite, centralized equals distributed,
+# finite-difference Jacobians over a run, noise identification over a run) whose code paths the
+# tests kept here walk already, at 50-90 s each under the sanitizers (CI must stay under 45 min).
+numeric_only='^(NavEndToEnd\.(CovariancesStaySymmetricPositiveDefinite|IdealCentralizedWithMeanWheelSpeedKeepsHeading|CentralizedEqualsDistributedWithoutConstraint|IdealSingleWheelInsAddsNoError|IdealMultiImuWithOwnWheelSpeedAddsNoError|CentralizedMeasurementJacobiansMatchFiniteDifference)|NoiseAdaptationEndToEnd\.(NoRunawayWithoutNoiseFigures|YawRateScaleFactorsByConfiguration)|FusionFaults\.NoFalseAlarmsOnAFaultFreeRun)$'
+ctest --test-dir "$build" -j"$(nproc)" --output-on-failure -E "$numeric_only"
