@@ -112,7 +112,7 @@ const std::vector<std::string> kVehicleKeys = {"track_m", "wheelbase_m", "antenn
 const std::vector<std::string> kModuleKeys = {
     "name",          "kind",          "group",        "chip",      "file",
     "format",        "layout",        "rate_hz",      "time_offset_s", "position_v_m",
-    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "axle_axis",  "wheel_radius_m", "odometry_radius_m", "gyro_range_dps",
+    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "axle_axis",  "wheel_radius_m", "odometry_radius_m", "steered", "gyro_range_dps",
     "accel_range_m_s2", "noise"};
 
 /// One noise key: its name, its unit factor and the ImuNoise member it fills.
@@ -352,6 +352,11 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
   } else if (s.kind == ModuleKind::kWheel) {
     fail(path, "missing required key 'wheel_radius_m' (every wheel module needs its wheel radius)", &n);
   }
+  if (auto v = get(n, "steered"); v.IsDefined()) {
+    s.steered = boolean(v, join(path, "steered"));
+    if (s.steered && s.kind != ModuleKind::kWheel)
+      fail(join(path, "steered"), "only a wheel module can be steered (this one is a body module)", &v);
+  }
   if (auto v = get(n, "odometry_radius_m"); v.IsDefined()) {
     s.odometry_radius = number(v, join(path, "odometry_radius_m"));
     range(s.odometry_radius, 0.01, 2.0, join(path, "odometry_radius_m"), v, "m (a wheel radius)");
@@ -371,6 +376,10 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
   s.noise_stated = 0;
   s.noise.acc_vrw = s.kind == ModuleKind::kWheel ? kDefaultWheelVrw : kDefaultBodyVrw;
   if (auto v = get(n, "noise"); v.IsDefined()) noise(v, join(path, "noise"), s);
+  if (s.steered && !(s.p_inV.x() >= 0.3))
+    fail(join(path, "position_v_m"),
+         "a steered wheel's x is its distance ahead of the rear axle (the v-frame origin o is the "
+         "mid rear axle): at least 0.3 m, got " + format_double(s.p_inV.x()), &n);
   return s;
 }
 
@@ -538,6 +547,9 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
              "+1: the axle axis points right, -1: left");
     if (wheel || s.wheel_radius != 0.0)
       w.line(4, "wheel_radius_m: " + num(s.wheel_radius), p + "wheel_radius_m");
+    if (s.steered)
+      w.line(4, "steered: true", p + "steered",
+             "turns with the steering; o is the mid rear axle, position x the distance ahead of it");
     if (s.odometry_radius > 0.0)
       w.line(4, "odometry_radius_m: " + num(s.odometry_radius), p + "odometry_radius_m",
              "for the raw axle rate (wheelins odometry)");

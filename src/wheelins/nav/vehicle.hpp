@@ -51,6 +51,11 @@ struct ImuModule {
   /// the b-frame stays right-handed; mounting_rpy then rotates the result (sensor_to_body()).
   int axle_axis = 0;
   double wheel_radius = 0.0;    ///< Wheel-IMU nominal wheel radius [m]
+  /// Wheel-IMU on a steered wheel: the wheel turns against the vehicle about its (vertical)
+  /// kingpin by the steering angle, which its subsystem estimates (filter/steering.hpp). The
+  /// v-frame origin o is then the mid rear (unsteered) axle: p_inV.x is the wheel's distance
+  /// ahead of it.
+  bool steered = false;
   /// Gyro full scale [rad/s] (readings at it are saturated); 0 = not stated.
   double gyro_range = 0.0;
   /// Accelerometer full scale [m/s^2]; 0 = not stated. A reading beyond either range (+5 %)
