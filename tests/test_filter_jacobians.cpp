@@ -112,6 +112,8 @@ WheelVelocityInput wheel_input(const Estimate& e, double mean_omega_x) {
 }  // namespace
 
 TEST(FilterJacobian, WheelVelocityMatchesFiniteDifference) {
+  // Level and unsteered; tilted and steered 20 deg (the level turned into the wheel's frame).
+  for (double steering : {0.0, 20.0 * kDeg})
   for (int axle_sign : {1, -1}) {
     const NavTruth t;
     const double mean_wx = -14.0;
@@ -121,11 +123,13 @@ TEST(FilterJacobian, WheelVelocityMatchesFiniteDifference) {
       const double mean = mean_wx + dx(BG) + mean_wx * dx(SG);
       WheelVelocityInput in = wheel_input(e, mean);
       in.axle_sign = axle_sign;
+      if (steering != 0.0) in.vehicle_roll = 0.03, in.vehicle_pitch = -0.02, in.steering = steering;
       set_own_wheel_speed(in, 0.097, mean);
       return wheel_velocity_model(in).innovation();
     };
     WheelVelocityInput in0 = wheel_input(perturb(t, Vec21::Zero()), mean_wx);
     in0.axle_sign = axle_sign;
+    if (steering != 0.0) in0.vehicle_roll = 0.03, in0.vehicle_pitch = -0.02, in0.steering = steering;
     set_own_wheel_speed(in0, 0.097, mean_wx);
     const WheelVelocityModel m = wheel_velocity_model(in0);
     const double eps = 1e-6;
@@ -138,7 +142,7 @@ TEST(FilterJacobian, WheelVelocityMatchesFiniteDifference) {
       const Vec3 col = (plus - minus) / (2 * eps);
       for (int i = 0; i < 3; ++i)
         EXPECT_NEAR(col(i), m.H(i, j), 1e-6 * (1.0 + std::abs(m.H(i, j))))
-            << "axle " << axle_sign << " H(" << i << "," << j << ")";
+            << "axle " << axle_sign << " steering " << steering << " H(" << i << "," << j << ")";
     }
   }
 }
@@ -189,7 +193,9 @@ TEST(FilterJacobian, BodyVelocityMatchesFiniteDifference) {
 }
 
 TEST(FilterJacobian, PositionConstraintMatchesFiniteDifference) {
-  for (bool wheel : {true, false}) {
+  // A body; a wheel; a steered wheel (turned 20 deg against the vehicle).
+  for (int kind : {0, 1, 2}) {
+    const bool wheel = kind > 0;
     NavTruth t;
     if (!wheel) t.C = dcm_from_euler(Vec3(0.02, -0.04, 1.3));
     ReferencePointInput base;
@@ -199,6 +205,10 @@ TEST(FilterJacobian, PositionConstraintMatchesFiniteDifference) {
     base.vehicle_roll = 0.03;
     base.vehicle_pitch = -0.02;
     base.C_BtoV = dcm_from_euler(Vec3(0.5, -0.8, 1.2) * kDeg);
+    if (kind == 2) {
+      base.steering = 20.0 * kDeg;
+      base.p_inV = Vec3(2.6, -0.75, 0.0);
+    }
     auto model_at = [&](const Vec21& dx) {
       const Estimate e = perturb(t, dx);
       ReferencePointInput in = base;
@@ -216,7 +226,7 @@ TEST(FilterJacobian, PositionConstraintMatchesFiniteDifference) {
       const Vec3 col = (plus - model_at(dx).r_o) / (2 * eps);
       for (int i = 0; i < 3; ++i)
         EXPECT_NEAR(col(i), m.H(i, j), 1e-6 * (1.0 + std::abs(m.H(i, j))))
-            << (wheel ? "wheel" : "body") << " H(" << i << "," << j << ")";
+            << "kind " << kind << " H(" << i << "," << j << ")";
     }
   }
 }
@@ -244,10 +254,15 @@ TEST(FilterJacobian, ReferencePointOfLevelWheelAndBody) {
 // the Body-INS attitude through the shared vehicle level (eq. 5, theta_3 and phi_3).
 
 TEST(FilterJacobian, WheelVelocityAndReferencePointLevelJacobians) {
+  // Level and steered wheels: a steered wheel's model takes the vehicle's level turned into
+  // its own heading frame, its H_level stays d/d the vehicle's roll and pitch.
+  for (double steering : {0.0, 0.35})
   for (double roll : {0.02, -0.3}) {
     const NavTruth t;
     WheelVelocityInput base = wheel_input(perturb(t, Vec21::Zero()), -14.0);
     base.vehicle_roll = roll;
+    base.vehicle_pitch = 0.05;
+    base.steering = steering;
     ReferencePointInput rp;
     rp.C_BtoW = t.C;
     rp.p_IinW = t.p;
@@ -255,6 +270,7 @@ TEST(FilterJacobian, WheelVelocityAndReferencePointLevelJacobians) {
     rp.p_inV = Vec3(0.01, -0.165, 0.02);
     rp.vehicle_roll = base.vehicle_roll;
     rp.vehicle_pitch = base.vehicle_pitch;
+    rp.steering = steering;
     const WheelVelocityModel m = wheel_velocity_model(base);
     const ReferencePointModel r = reference_point_model(rp);
     const double eps = 1e-6;
@@ -273,7 +289,7 @@ TEST(FilterJacobian, WheelVelocityAndReferencePointLevelJacobians) {
       const Vec3 dr = (ro_at(eps) - ro_at(-eps)) / (2 * eps);
       for (int i = 0; i < 3; ++i) {
         EXPECT_NEAR(dv(i), m.H_level(i, k), 1e-7 * (1.0 + std::abs(m.H_level(i, k))))
-            << "velocity roll " << roll << " (" << i << "," << k << ")";
+            << "velocity roll " << roll << " steering " << steering << " (" << i << "," << k << ")";
         EXPECT_NEAR(dr(i), r.H_level(i, k), 1e-8) << "reference point (" << i << "," << k << ")";
       }
     }

@@ -491,10 +491,10 @@ TEST_F(Survey, NoDataChecksRunsTheManifestAsItIs) {
 
 // ------------------------------------------------------------------ steering
 
-TEST_F(Survey, SteeredWheelIsAWarningInFullAndDraftedAtTheFront) {
+TEST_F(Survey, SteeredWheelIsDraftedSteeredAndAWarningWhereTheManifestSaysNot) {
   // The simulated wheels are the rear ones: the survey's finding for one is set as a steered
   // wheel's would be, and the checks and the draft read it.
-  const Manifest m = manifest(data());
+  Manifest m = manifest(data());
   survey::DatasetSurvey s = survey_of(m);
   for (survey::ModuleFinding& f : s.modules)
     if (f.module == "left-C1") {
@@ -508,8 +508,11 @@ TEST_F(Survey, SteeredWheelIsAWarningInFullAndDraftedAtTheFront) {
   EXPECT_EQ(checks[0].module, "left-C1");
   const std::string& w = checks[0].message;
   EXPECT_HAS(w, "module 'left-C1': its yaw rate leads the vehicle's by 0.35 s and departs from it by 80 %");
-  const std::string end = "navigate with the unsteered wheels";
-  EXPECT_TRUE(w.size() >= end.size() && w.compare(w.size() - end.size(), end.size(), end) == 0) << w;
+  EXPECT_HAS(w, "set steered: true");
+  // A manifest that says so: nothing to warn about.
+  for (auto& spec : m.modules)
+    if (spec.name == "left-C1") spec.steered = true;
+  EXPECT_TRUE(survey::check_against_data(m, kModules, s).empty());
 
   std::vector<survey::DraftModule> drafts;
   for (const std::string& name : kModules) {
@@ -522,7 +525,9 @@ TEST_F(Survey, SteeredWheelIsAWarningInFullAndDraftedAtTheFront) {
   const ManifestDraft d = survey::draft_from_survey(s, drafts, {});
   const survey::VehicleType car = survey::vehicle_type("car");
   EXPECT_EQ(d.manifest.find("left-C1")->p_inV.x(), car.wheelbase);
+  EXPECT_TRUE(d.manifest.find("left-C1")->steered);
   EXPECT_EQ(d.manifest.find("right-C1")->p_inV.x(), 0.0);
+  EXPECT_FALSE(d.manifest.find("right-C1")->steered);
   std::string facts;
   for (const auto& f : d.facts) facts += f + "\n";
   EXPECT_HAS(facts, "left-C1: a steered wheel");

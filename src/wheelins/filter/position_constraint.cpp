@@ -11,7 +11,7 @@ ReferencePointModel reference_point_model(const ReferencePointInput& in) {
   ReferencePointModel m;
   m.H.block<3, 3>(0, P) = Mat3::Identity();
   if (in.wheel) {
-    const double psi = wheel_vehicle_heading(C, in.axle_sign);
+    const double psi = wheel_vehicle_heading(C, in.axle_sign) - in.steering;
     const Mat3 Rz = rot_z(psi), Ryx = rot_y(in.vehicle_pitch) * rot_x(in.vehicle_roll);
     const Vec3 a = Ryx * in.p_inV;            // so that C_v^w r^v = Rz(psi) a
     const Vec3 Cl = C * in.lever_arm_inB;

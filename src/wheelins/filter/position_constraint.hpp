@@ -22,6 +22,8 @@ struct ReferencePointInput {
   Vec3 p_inV = Vec3::Zero();          ///< wheel centre (wheel) or IMU centre (body) in v
   int axle_sign = 1;                  ///< Wheel-IMU
   double vehicle_roll = 0.0, vehicle_pitch = 0.0;  ///< Wheel-IMU: shared level
+  /// Wheel-IMU on a steered wheel: its steering angle (its heading less the vehicle's) [rad].
+  double steering = 0.0;
   Mat3 C_BtoV = Mat3::Identity();     ///< Body-IMU mounting
 };
 

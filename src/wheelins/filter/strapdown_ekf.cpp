@@ -103,6 +103,14 @@ void StrapdownEkf::feedback(const Vec21& dx) {
   feedback_total_ += dx;
 }
 
+void StrapdownEkf::rotate_about_vertical(double angle, const Vec3& pivot) {
+  const Mat3 R = rot_z(angle);
+  state_.q_ItoW = (Quat(R) * state_.q_ItoW).normalized();
+  state_.v_IinW = R * state_.v_IinW;
+  state_.p_IinW = pivot + R * (state_.p_IinW - pivot);
+  ++revision_;
+}
+
 void StrapdownEkf::set_noise(const ProcessNoise& noise) {
   // The held states must stay what they were at initialize(): their rows of P are zero.
   noise_.gyro_arw = noise.gyro_arw;

@@ -120,6 +120,11 @@ class StrapdownEkf {
 
   /// Applies an error estimate (position, velocity, attitude, sensor errors) to the state.
   void feedback(const Vec21& dx);
+  /// Turns the navigation state by `angle` about the w-frame's vertical through `pivot`
+  /// (attitude, velocity, and the position's offset from the pivot); a steered wheel's start
+  /// (filter/steering.hpp). The covariance is kept (the turn comes within a metre of travel,
+  /// where the position's and velocity's are level-isotropic to first order).
+  void rotate_about_vertical(double angle, const Vec3& pivot);
   /// Replaces the sensor-error estimates (e.g. with earlier ones after a fault).
   void set_errors(const ImuErrors& e) {
     errors_ = e;

@@ -13,6 +13,12 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
       opt_(opt),
       C_StoB_(wheel_sensor_to_body(module)),
       axle_sign_(module.axle_sign) {
+  // A steered wheel's speed and geometry change with the steering over a turn: no whole-turn
+  // averages for it.
+  if (module.steered) {
+    opt_.turn_average = false;
+    steer_ = SteeringObserver(module.p_inV.x(), opt.steering);
+  }
   // Its b x-axis is the axle: the attitude update splits the spin off (nav/mechanization.hpp).
   mech_.spin_about_x = true;
   window_len_ = std::clamp(static_cast<int>(std::lround(opt.speed_window * module.rate_hz)), 1,
@@ -27,7 +33,7 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
   // The accelerometer along the axle sees the lateral specific force only: its scale factor
   // and its bias differ only where the course turns both ways (held as well).
   if (!opt.estimate_axle_accel_scale_factor) noise_.estimated(SA + 0) = 0.0;
-  if (opt.turn_average)
+  if (opt_.turn_average)
     turns_.reserve(std::clamp(static_cast<int>(std::ceil(opt.turn_window * module.rate_hz)) + 1, 2,
                               kMaxTurnEpochs));
 }
@@ -43,7 +49,8 @@ void WheelIns::start(const StaticAccumulator& stat, double vehicle_heading, doub
   // Roll (the wheel angle) and pitch from the mean specific force; the b x-axis points
   // along the axle, so the IMU yaw is the vehicle heading + axle_sign * 90 deg.
   Vec3 rpy = level_from_specific_force(stat.mean_f());
-  rpy.z() = wrap_pi(vehicle_heading + axle_sign_ * 0.5 * kPi);
+  steer_.arm(0.0);  // a steered wheel's delta_0 is measured as it starts to roll
+  rpy.z() = wrap_pi(vehicle_heading + steering() + axle_sign_ * 0.5 * kPi);
   NavState s;
   s.t = t0;
   s.q_ItoW = Quat(dcm_from_euler(rpy)).normalized();
@@ -65,7 +72,8 @@ void WheelIns::restart(const Vec3& mean_f_inB, const VehicleFix& fix) {
   // As start(), in motion: the wheel angle and axle tilt from the averaged specific force,
   // the axle direction from the vehicle heading, the IMU placed from o by eq. (7).
   Vec3 rpy = level_from_specific_force(mean_f_inB);
-  rpy.z() = wrap_pi(fix.heading + axle_sign_ * 0.5 * kPi);
+  steer_.arm(steer_.angle());  // measured again over the first metres
+  rpy.z() = wrap_pi(fix.heading + steering() + axle_sign_ * 0.5 * kPi);
   NavState s;
   s.t = fix.t;
   s.q_ItoW = Quat(dcm_from_euler(rpy)).normalized();
@@ -87,7 +95,7 @@ double WheelIns::ins_speed() const {
   const Mat3 C = s.C_ItoW();
   const Vec3 omega_nb = ekf_.omega_ib_b() - C.transpose() * mech_.omega_ie_inW;
   const Vec3 v_wc = s.v_IinW + C * omega_nb.cross(module_.lever_arm_inB);
-  return (C_VtoW().transpose() * v_wc).x();
+  return ((C_VtoW() * rot_z(steering())).transpose() * v_wc).x();  // along the wheel
 }
 
 void WheelIns::propagate(const ImuSample& body_sample) {
@@ -101,6 +109,13 @@ void WheelIns::propagate(const ImuSample& body_sample) {
   window_[window_pos_] = wx;
   window_sum_ += wx;
   window_pos_ = (window_pos_ + 1) % window_len_;
+  if (module_.steered) {
+    const SteeringObserver::Step st =
+        steer_.step(yaw_rate(), wheel_speed(), body_sample.dt,
+                    wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_), reference_heading_);
+    if (st.rolling_began) roll_pivot_ = ekf_.state().p_IinW;
+    if (st.turn != 0.0) ekf_.rotate_about_vertical(st.turn, roll_pivot_);
+  }
   if (opt_.turn_average) {
     // Models kept from before a restart or replaced estimates are not comparable.
     if (ekf_.revision() != turns_revision_) {
@@ -150,6 +165,7 @@ WheelVelocityInput WheelIns::own_velocity_input() const {
   in.lever_arm_inB = module_.lever_arm_inB;
   in.vehicle_roll = vehicle_roll_;
   in.vehicle_pitch = vehicle_pitch_;
+  in.steering = steering();
   in.axle_sign = axle_sign_;
   set_own_wheel_speed(in, module_.wheel_radius, mean_omega_x());
   return in;
@@ -172,6 +188,7 @@ ReferencePointInput WheelIns::reference_point_input() const {
   in.lever_arm_inB = module_.lever_arm_inB;
   in.p_inV = module_.p_inV;
   in.axle_sign = axle_sign_;
+  in.steering = steering();
   in.vehicle_roll = vehicle_roll_;
   in.vehicle_pitch = vehicle_pitch_;
   return in;
@@ -186,11 +203,13 @@ Vec3 WheelIns::reference_velocity_inW() const {
   const Mat3 C = s.C_ItoW();
   const Vec3 omega_nb = ekf_.omega_ib_b() - C.transpose() * mech_.omega_ie_inW;
   const Vec3 v_wc = s.v_IinW + C * omega_nb.cross(module_.lever_arm_inB);
-  // The vehicle turns with the wheel's angular rate less its spin about the axle.
+  // The vehicle turns with the wheel's angular rate less its spin about the axle (and less
+  // the steering rate about the vehicle's vertical).
   const Vec3 omega_inW = C * omega_nb;
   const Vec3 axle = C.col(0);
-  const Vec3 omega_vehicle = omega_inW - omega_inW.dot(axle) * axle;
-  return v_wc - omega_vehicle.cross(C_VtoW() * module_.p_inV);
+  const Mat3 C_v = C_VtoW();
+  const Vec3 omega_vehicle = omega_inW - omega_inW.dot(axle) * axle - steering_rate() * C_v.col(2);
+  return v_wc - omega_vehicle.cross(C_v * module_.p_inV);
 }
 
 }  // namespace wheelins

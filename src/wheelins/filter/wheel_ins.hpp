@@ -6,6 +6,7 @@
 
 #include <array>
 
+#include "wheelins/filter/steering.hpp"
 #include "wheelins/filter/subsystem.hpp"
 #include "wheelins/filter/turn_average.hpp"
 #include "wheelins/filter/wheel_velocity.hpp"
@@ -35,6 +36,8 @@ struct WheelInsOptions {
   /// The longest span kept for it [s]; slower than a turn in this, the update is the
   /// instantaneous one.
   double turn_window = 4.0;
+  /// A steered wheel's steering observer (ImuModule::steered; filter/steering.hpp).
+  SteeringOptions steering;
 };
 
 class WheelIns final : public Subsystem {
@@ -65,9 +68,29 @@ class WheelIns final : public Subsystem {
   SpeedSensitivity speed_sensitivity() const;
   /// The b-frame x rate this wheel turns at when rolling at `speed` [rad/s].
   double omega_x_at_speed(double speed) const { return -axle_sign_ * speed / module_.wheel_radius; }
-  /// Vehicle yaw rate (w-frame z, down: positive turning right) from this gyro less its
-  /// spin about the axle [rad/s].
+  /// This wheel's yaw rate (w-frame z, down: positive turning right) from its gyro less its
+  /// spin about the axle [rad/s]: the vehicle's, plus the steering rate of a steered wheel.
   double yaw_rate() const;
+  /// The vehicle's yaw rate from this wheel (its own less the steering rate) [rad/s].
+  double vehicle_yaw_rate() const { return yaw_rate() - steering_rate(); }
+  bool steered() const { return module_.steered; }
+  /// A steered wheel's start is over (its steering measured; filter/steering.hpp).
+  bool steering_settled() const { return !module_.steered || steer_.settled(); }
+  /// The vehicle's heading from another IMU for a steered wheel's start (NaN: none), taken
+  /// by the next propagate().
+  void set_reference_heading(double heading) { reference_heading_ = heading; }
+  /// The steering angle: this wheel's heading less the vehicle's (0 unless steered) [rad].
+  double steering() const { return module_.steered ? steer_.angle() : 0.0; }
+  double steering_rate() const { return module_.steered ? steer_.rate() : 0.0; }
+  /// The vehicle's forward speed (v-frame x) at this wheel's centre: its speed along the wheel
+  /// times cos(steering) [m/s]; the same along the whole line parallel to x through it, so
+  /// it is also that of the point on the rear axle's line beside it (speed_point_inV()).
+  double longitudinal_speed() const { return wheel_speed() * std::cos(steering()); }
+  /// Where the vehicle moves at longitudinal_speed() with no side slip: the wheel centre, or
+  /// for a steered wheel the point on the rear axle's line beside it (v-frame) [m].
+  Vec3 speed_point_inV() const {
+    return module_.steered ? Vec3(0.0, module_.p_inV.y(), module_.p_inV.z()) : module_.p_inV;
+  }
   /// Forward speed of the wheel centre from the filter's own velocity [m/s].
   double ins_speed() const;
   /// Its velocity measurement noise covariance (Table 9).
@@ -90,7 +113,7 @@ class WheelIns final : public Subsystem {
     vehicle_pitch_ = pitch;
   }
   double vehicle_heading() const override {
-    return wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_);
+    return wrap_pi(wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_) - steering());
   }
   Eigen::RowVector3d heading_sensitivity() const override;
   Mat3 C_VtoW() const;
@@ -112,6 +135,9 @@ class WheelIns final : public Subsystem {
   double window_sum_ = 0.0;
   TurnAverager turns_;
   int turns_revision_ = -1;
+  SteeringObserver steer_;
+  double reference_heading_ = SteeringObserver::kNoHeading;
+  Vec3 roll_pivot_ = Vec3::Zero();  // where the IMU was when a steered wheel began to roll
 };
 
 }  // namespace wheelins

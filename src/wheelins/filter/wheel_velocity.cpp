@@ -37,9 +37,13 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   const Mat3& C = in.C_BtoW;
   const Vec3& l = in.lever_arm_inB;
   const double psi = wheel_vehicle_heading(C, in.axle_sign);
+  // The level in the wheel's heading frame (a steered wheel's is turned by the steering).
+  const double cs = std::cos(in.steering), sn = std::sin(in.steering);
+  const double roll = cs * in.vehicle_roll + sn * in.vehicle_pitch;
+  const double pitch = -sn * in.vehicle_roll + cs * in.vehicle_pitch;
 
   // C_v^w = Rz(psi) Ry(theta) Rx(phi); its transpose maps w-frame vectors into the v-frame.
-  const Mat3 Rz = rot_z(psi), Ryx = rot_y(in.vehicle_pitch) * rot_x(in.vehicle_roll);
+  const Mat3 Rz = rot_z(psi), Ryx = rot_y(pitch) * rot_x(roll);
   const Mat3 C_WtoV = (Rz * Ryx).transpose();
 
   const Vec3 omega_nb = in.omega_ib_b - C.transpose() * in.omega_ie_inW;
@@ -66,9 +70,15 @@ WheelVelocityModel wheel_velocity_model(const WheelVelocityInput& in) {
   m.H.block<3, 3>(0, SG) = Hbg * in.omega_ib_b.asDiagonal();
   set_measured_speed(m, in.measured_speed, in.dspeed_dbgx, in.dspeed_dsgx);
   // z_hat = Rx(phi)^T Ry(theta)^T Rz^T u; d Rx^T/d phi = -[e_x x] Rx^T, same for Ry.
-  const Mat3 Rx = rot_x(in.vehicle_roll), Ry = rot_y(in.vehicle_pitch);
+  const Mat3 Rx = rot_x(roll), Ry = rot_y(pitch);
   m.H_level.col(0) = -skew(Vec3::UnitX()) * C_WtoV * u;
   m.H_level.col(1) = -Rx.transpose() * skew(Vec3::UnitY()) * Ry.transpose() * Rz.transpose() * u;
+  if (in.steering != 0.0) {
+    // d [roll', pitch'] / d [roll, pitch] = [c s; -s c].
+    Eigen::Matrix2d T;
+    T << cs, sn, -sn, cs;
+    m.H_level = (m.H_level * T).eval();
+  }
 
   return m;
 }

@@ -24,6 +24,11 @@ struct WheelVelocityInput {
   Vec3 omega_ie_inW = Vec3::Zero();  ///< earth rate in the w-frame (zero if ignored)
   Vec3 lever_arm_inB = Vec3::Zero(); ///< IMU centre -> wheel centre [m]
   double vehicle_roll = 0.0, vehicle_pitch = 0.0;  ///< [rad]
+  /// A steered wheel's steering angle [rad] (filter/steering.hpp): the model holds in the
+  /// wheel's own heading frame, whose level is the vehicle's turned by it (to first order in
+  /// the tilt: roll' = c roll + s pitch, pitch' = -s roll + c pitch); H_level stays d/d the
+  /// vehicle's [roll, pitch].
+  double steering = 0.0;
   int axle_sign = 1;
   double measured_speed = 0.0;       ///< forward wheel speed [m/s]
   /// Sensitivity of measured_speed to this IMU's residual gyro-x bias and scale factor

@@ -124,13 +124,14 @@ bool FaultPolicy::substitute_speed(int wheel_index, double* speed) const {
   for (int j = 0; j < subs_.size(); ++j)
     if (j != wheel_index && subs_.is_wheel(j) && monitor_.counts(j) &&
         t - rt_[j].saturated_until > kSaturationFree) {
-      // Moved to this wheel: v_i = v_j - yaw_rate (y_i - y_j) (v-frame y to the right).
+      // Moved to this wheel: v_i = v_j - yaw_rate (y_i - y_j) (v-frame y to the right; the
+      // vehicle's forward speeds, a steered wheel's along itself over cos(steering)).
       const auto& wj = subs_.wheel(j);
-      sum += wj.wheel_speed() -
-             wj.yaw_rate() * (subs_[wheel_index].module().p_inV.y() - wj.module().p_inV.y());
+      sum += wj.longitudinal_speed() - wj.vehicle_yaw_rate() * (subs_[wheel_index].module().p_inV.y() -
+                                                                wj.module().p_inV.y());
       ++n;
     }
-  if (n) *speed = sum / n;
+  if (n) *speed = sum / n / std::cos(subs_.wheel(wheel_index).steering());
   return n > 0;
 }
 
@@ -185,7 +186,7 @@ void FaultPolicy::check_wheel_speeds(double t, const std::array<WheelVelocityInp
     const Mat21& P = filter_.covariance(i, scratch);
     const double s_xx = m.H.row(0) * P * m.H.row(0).transpose() + w.velocity_noise()(0, 0);
     z[i] = std::abs(m.innovation().x()) / std::sqrt(s_xx);
-    yaw_rate += w.yaw_rate();
+    yaw_rate += w.vehicle_yaw_rate();
     ++n_u;
   }
   if (n_u < 2) return;
@@ -193,11 +194,13 @@ void FaultPolicy::check_wheel_speeds(double t, const std::array<WheelVelocityInp
   int suspect = -1;
   for (int i = 0; i < n; ++i) {
     if (!speed_ok[i] || !subs_.is_wheel(i)) continue;
-    const double vi = own[i].measured_speed, yi = subs_[i].module().p_inV.y();
+    // The vehicle's forward speeds (a steered wheel's along itself times cos(steering)).
+    const double vi = own[i].measured_speed * std::cos(own[i].steering), yi = subs_[i].module().p_inV.y();
     double pred = 0.0;
     for (int j = 0; j < n; ++j)
       if (j != i && speed_ok[j] && subs_.is_wheel(j))
-        pred += own[j].measured_speed - yaw_rate * (yi - subs_[j].module().p_inV.y());
+        pred += own[j].measured_speed * std::cos(own[j].steering) -
+                yaw_rate * (yi - subs_[j].module().p_inV.y());
     pred /= n_u - 1;
     bool disagrees = z[i] > opt_.speed_gate &&
                      std::abs(vi - pred) > std::max(opt_.wheel_mismatch, 0.1 * std::abs(pred));

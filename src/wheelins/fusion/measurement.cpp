@@ -2,6 +2,8 @@
 // point, and the velocity (eq. 5, 6) and position-constraint (eq. 11) measurements.
 #include "wheelins/fusion/measurement.hpp"
 
+#include <cmath>
+
 namespace wheelins {
 
 namespace {
@@ -42,10 +44,13 @@ void take_mean_speed(const Subsystems& subs, const SpeedSelection& sel, SharedIn
   sh.speeds = sel;
   sh.mean_speed = 0.0;
   sh.mean_point.setZero();
+  // A steered wheel's speed along the wheel is the vehicle's forward speed over
+  // cos(steering), which is the speed of the point on the rear axle's line beside it.
   for (int j = 0; j < subs.size(); ++j)
     if (sel.in_mean[j]) {
-      sh.mean_speed += sh.wheel[j].measured_speed;
-      sh.mean_point += subs[j].module().p_inV;
+      const WheelIns& w = subs.wheel(j);
+      sh.mean_speed += sh.wheel[j].measured_speed * std::cos(sh.wheel[j].steering);
+      sh.mean_point += w.speed_point_inV();
     }
   if (sel.n_mean) {
     sh.mean_speed /= sel.n_mean;
@@ -97,7 +102,7 @@ void velocity_measurement(const Subsystems& subs, const SharedInputs& sh, const 
       m.R(0, 0) = kNoSpeedVar;
     }
     if (mean) {
-      in.measured_speed = sh.mean_speed;
+      in.measured_speed = sh.mean_speed / std::cos(in.steering);  // along this wheel
       in.dspeed_dbgx = in.dspeed_dsgx = 0.0;
     }
     // Over whole turns when this wheel averages and every speed it uses has the same mean.

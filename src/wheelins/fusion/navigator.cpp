@@ -61,6 +61,9 @@ void Navigator::process(int index, const ImuSample& raw) {
     start_navigation(static_end_);
   }
   if (!faults_->on_sample(index, raw, b)) return;
+  // A steered wheel's start takes the vehicle's heading from an IMU that does not steer.
+  if (s.is_wheel() && !subs_.wheel(index).steering_settled())
+    subs_.wheel(index).set_reference_heading(unsteered_heading(index));
   // Mechanization, and the covariance time update when due (the filter's).
   s.propagate(b);
   filter_->propagated(index);
@@ -175,6 +178,17 @@ void Navigator::select_speeds(double t) {
         sel.speed_ok[i] = sel.in_mean[i] = true;
         ++sel.n_mean;
       }
+  // Unsteered wheels measure the vehicle's forward speed directly; a steered wheel's depends
+  // on its estimated steering: it counts in the mean only when no unsteered wheel does.
+  bool unsteered = false;
+  for (int i = 0; i < subs_.size(); ++i)
+    unsteered = unsteered || (sel.in_mean[i] && !subs_.wheel(i).steered());
+  if (unsteered)
+    for (int i = 0; i < subs_.size(); ++i)
+      if (sel.in_mean[i] && subs_.wheel(i).steered()) {
+        sel.in_mean[i] = false;
+        --sel.n_mean;
+      }
 }
 
 void Navigator::count_velocity_update(int i, const UpdateReport& rep, double t) {
@@ -182,6 +196,18 @@ void Navigator::count_velocity_update(int i, const UpdateReport& rep, double t) 
   if (!rep.accepted) ++stats_.velocity_rejected;
   stats_.max_velocity_test_ratio = std::max(stats_.max_velocity_test_ratio, rep.test_ratio);
   faults_->on_velocity_update(i, rep, t);
+}
+
+double Navigator::unsteered_heading(int except) const {
+  // A counted subsystem that does not steer, a body first (its heading is its own attitude's).
+  int best = -1;
+  for (int j = 0; j < subs_.size(); ++j) {
+    if (j == except || !faults_->counted(j) || !subs_[j].ekf().initialized()) continue;
+    if (subs_.is_wheel(j) && subs_.wheel(j).steered()) continue;
+    if (best < 0 || !subs_.is_wheel(j)) best = j;
+    if (!subs_.is_wheel(j)) break;
+  }
+  return best < 0 ? SteeringObserver::kNoHeading : subs_[best].vehicle_heading();
 }
 
 bool Navigator::level_shared() const {

@@ -92,6 +92,9 @@ class Navigator {
   void position_step();
   /// The Body-INS level is shared: sharing on and the Body-INS counted.
   bool level_shared() const;
+  /// The vehicle's heading from a counted subsystem that does not steer, other than `except`
+  /// (a steered wheel's start); SteeringObserver::kNoHeading with none.
+  double unsteered_heading(int except) const;
   /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
   void share_level();
   /// The wheel speeds of this velocity step: the paper's mean over the wheels, less what

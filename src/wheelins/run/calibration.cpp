@@ -64,9 +64,22 @@ InstallationCalibration ModuleCalibrators::result() const {
       bodies.push_back(impl_->body[k].get());
     }
   }
-  estimate_relative_radius(views, impl_->opt, out.wheels);
-  // A Body-IMU's yaw (and position) against the axle accelerometers of every Wheel-IMU in the run.
-  for (std::size_t b = 0; b < bodies.size(); ++b) estimate_body_yaw(*bodies[b], views, out.wheels, impl_->opt, out.bodies[b]);
+  // The relative radius (the two sides' speed difference against the yaw rate) and a Body-IMU's
+  // yaw and position (against the wheels' axle accelerometers) hold for wheels that do not
+  // steer: a steered wheel's speed and axle turn with the steering.
+  std::vector<const WheelImuCalibrator*> fixed;
+  std::vector<WheelImuCalibration> fixed_results;
+  std::vector<std::size_t> fixed_index;
+  for (std::size_t i = 0; i < views.size(); ++i)
+    if (!views[i]->module().steered) {
+      fixed.push_back(views[i]);
+      fixed_results.push_back(out.wheels[i]);
+      fixed_index.push_back(i);
+    }
+  estimate_relative_radius(fixed, impl_->opt, fixed_results);
+  for (std::size_t j = 0; j < fixed.size(); ++j) out.wheels[fixed_index[j]] = fixed_results[j];
+  for (std::size_t b = 0; b < bodies.size(); ++b)
+    estimate_body_yaw(*bodies[b], fixed, fixed_results, impl_->opt, out.bodies[b]);
   return out;
 }
 

@@ -104,6 +104,8 @@ std::vector<std::string> check_manifest_against_data(const Manifest& m, const st
                                                      const WarningSink& warn) {
   survey::SurveyOptions so;
   so.series.max_span = 300.0;  // the checks need minutes of driving, not hours
+  for (const auto& name : modules)
+    if (const ModuleSpec* s = m.find(name); s && s->steered) so.steered.push_back(name);
   const survey::DatasetSurvey s = survey::survey_modules(survey::survey_inputs(m, modules), so);
   std::string errors;
   for (const auto& c : survey::check_against_data(m, modules, s)) {

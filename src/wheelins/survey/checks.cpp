@@ -191,11 +191,12 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
                   " (it turns faster than the other side's wheels in " + (f->side > 0 ? "left" : "right") +
                   fmt(" turns; evidence %.2f), but its position_v_m y is %+.3f m: swap the sides", f->side_evidence,
                       spec->p_inV.y()));
-      if (f->steered)
-        warning(spec->name, "",
+      if (f->steered && !spec->steered)
+        warning(spec->name, key + "steered",
                 who + fmt(": its yaw rate leads the vehicle's by %.2f s and departs from it by %.0f %% like a steered "
-                          "wheel's; wheelins takes every wheel as unsteered, so its heading follows the steering: "
-                          "navigate with the unsteered wheels", f->yaw_lead, 100.0 * f->yaw_departure));
+                          "wheel's, but the manifest takes it as unsteered (its heading would follow the steering): "
+                          "set steered: true (and its position_v_m x to its distance ahead of the rear axle)",
+                          f->yaw_lead, 100.0 * f->yaw_departure));
     }
 
     if (spec->kind == ModuleKind::kBody && f->kind == ModuleKind::kBody && f->traits.rest_found) {

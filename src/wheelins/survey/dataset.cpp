@@ -196,7 +196,9 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
         // drive without turns) by the size of the horizontal acceleration.
         for (int w : wheels) {
           const std::size_t j = static_cast<std::size_t>(w);
-          if (!to_w0[j].found) continue;
+          if (!to_w0[j].found ||
+              std::find(o.steered.begin(), o.steered.end(), S[j].module) != o.steered.end())
+            continue;
           const ClockFit f = fit_clock_offset(signal(i, yaw[i]), signal(j, yaw[j]), o.clock);
           if (f.found && f.correlation >= o.min_clock_correlation && (!best.found || f.correlation > best.correlation)) {
             best = combine(f, to_w0[j], -1.0);

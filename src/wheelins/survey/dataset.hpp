@@ -46,6 +46,9 @@ struct SurveyOptions {
   ClockOptions clock;
   double min_static = 2.0;       ///< [s] shortest static period drafted
   double static_margin = 0.3;    ///< [s] taken off both ends of the common rest
+  /// Wheels known to steer (a manifest's steered: true): their yaw rate leads the vehicle's,
+  /// so no body's clock is tied through it.
+  std::vector<std::string> steered;
   double steering_ratio = 0.5;   ///< yaw departure (rms, over the vehicle's rms yaw rate) of a steered wheel
   double steering_lead = 0.2;    ///< [s] a steered wheel's yaw rate leads the vehicle's by more
   double min_turning = 0.03;     ///< [rad/s] rms yaw rate of the vehicle below which steering is not judged

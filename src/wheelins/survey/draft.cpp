@@ -126,9 +126,12 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
         note[key + "position_v_m"] = "from the data: " + where + "; x, y TODO" + typical;
         note[key + "mounting_deg"] = "estimated from the data by every run (calibration.yaml)";
       }
-      if (f->steered)
+      s.steered = f->steered || (prior && prior->steered);
+      if (f->steered) {
+        note[key + "steered"] = fmt("from the data: its yaw rate leads the vehicle's by %.2f s", f->yaw_lead);
         d.facts.push_back(in.name + fmt(": a steered wheel (its yaw rate leads the vehicle's by %.2f s): "
-                                        "navigate with the unsteered wheels", f->yaw_lead));
+                                        "steered: true, its steering angle estimated by every run", f->yaw_lead));
+      }
     } else {
       s.lever_arm_inB = Vec3::Zero();
       s.p_inV = vt.body_position;
