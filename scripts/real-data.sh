@@ -46,5 +46,11 @@ for t in "${trials[@]}"; do
   row "body/wheel" "$bin" run -m "$m" -c body-wheel -o "$out/$t-x/body-wheel" -q --formats tum "${ant[@]}"
   row "triple" "$bin" run -m "$m" -c triple -o "$out/$t-x/triple" -q --formats tum "${ant[@]}"
   row "triple centralized" "$bin" run -m "$m" -c triple --centralized -o "$out/$t-x/triple-c" -q --formats tum "${ant[@]}"
+  # The steered front wheels (IMU3 left, IMU1 right; steered: true, drafted from the data).
+  row "single (left front)" "$bin" run -m "$m" --modules IMU3 -o "$out/$t-x/single-front" -q --formats tum "${ant[@]}"
+  row "single (right front)" "$bin" run -m "$m" --modules IMU1 -o "$out/$t-x/single-right-front" -q --formats tum "${ant[@]}"
+  row "dual (front pair)" "$bin" run -m "$m" --modules IMU3,IMU1 -o "$out/$t-x/dual-front" -q --formats tum "${ant[@]}"
+  row "triple (front pair)" "$bin" run -m "$m" --modules CAR,IMU3,IMU1 -o "$out/$t-x/triple-front" -q --formats tum "${ant[@]}"
+  row "four hubs + body" "$bin" run -m "$m" --modules CAR,IMU4,IMU2,IMU3,IMU1 -o "$out/$t-x/five" -q --formats tum "${ant[@]}"
   row "naive dead reckoning" "$bin" odometry -m "$m" "${ant[@]}"
 done
