@@ -131,7 +131,9 @@ const bool registered = wheelins::cli::register_command(
                      "default (T-shaped loop, 5 laps) or a path file: .kml (<LineString>) or .csv")
           ->capture_default_str();
       sub.add_option("--speed", o->speed_file, "odo.bin (t, speed) timing the path (with a path file)");
-      sub.add_option("--preset", o->preset, "vehicle preset: robot (default) or car");
+      sub.add_option("--preset", o->preset,
+                     "vehicle preset: robot (default), car, or car-steered (the car with two more "
+                     "Wheel-IMUs on its steered front wheels)");
       sub.add_option("--profile", o->profile, "error profile: field (default), datasheet or ideal");
       sub.add_option("--seed", o->seed, "random seed (default 1)");
       sub.add_option("--duration", o->duration, "seconds from the start (default: whole scenario)");

@@ -93,8 +93,12 @@ ErrorParams profile_errors(const std::string& profile);
 
 /// One physical module (a group of four chips).
 struct ModuleGeometry {
-  std::string group;            ///< "left-wheel", "right-wheel", "body"
+  std::string group;            ///< "left-wheel", "right-wheel", "body", "front-left-wheel", ...
   bool wheel = true;
+  /// A steered wheel (preset car-steered): it turns about the vehicle's z through its centre
+  /// by the Ackermann angle of the path's curvature (docs/simulator.md); p_inV.x is its distance
+  /// ahead of o, the mid rear axle.
+  bool steered = false;
   Vec3 p_inV = Vec3::Zero();    ///< wheel centre (wheel) / IMU centre (body) [m]
   Vec3 lever_arm_inB = Vec3::Zero();  ///< wheel: IMU centre -> wheel centre, b-frame [m]
   Vec3 mounting_rpy = Vec3::Zero();   ///< wheel: C_s^b; body: C_b^v (ZYX Euler) [rad]
@@ -104,9 +108,19 @@ struct VehicleConfig {
   std::string preset = "robot";
   double wheel_radius = 0.097;  ///< nominal [m]
   double track = 0.33;          ///< [m]
+  /// Rear to front axle [m]; 0: not stated (robot, car). The steered wheels' x follows it.
+  double wheelbase = 0.0;
   ModuleGeometry left, right, body;
-  /// Wheel centres at (0, -/+ track/2, 0) unless overridden.
+  /// The steered front wheels (car-steered: front-left-wheel, front-right-wheel), else empty.
+  std::vector<ModuleGeometry> front;
+  /// Wheel centres at (0, -/+ track/2, 0) (front wheels: (wheelbase, -/+ track/2, 0)) unless
+  /// overridden. Presets: robot, car, car-steered (the car with two steered front Wheel-IMUs).
   static VehicleConfig preset_named(const std::string& name);
+  /// Every module in group order: left, right, body, then the front wheels.
+  std::vector<const ModuleGeometry*> modules() const;
+  std::vector<ModuleGeometry*> mutable_modules();
+  /// The car's scenario defaults (speed, size, smoothing) apply: presets car and car-steered.
+  bool car() const { return preset == "car" || preset == "car-steered"; }
 };
 
 struct SimConfig {

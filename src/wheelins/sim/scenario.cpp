@@ -29,6 +29,14 @@ J compose(const double* f, const J& u) {
   return r;
 }
 
+/// The signed curvature of a horizontal curve (north, east) from its first and second
+/// derivatives with respect to any parameter: positive turning right (clockwise seen from above).
+J horizontal_curvature(const J& xn, const J& xe, const J& xnn, const J& xee) {
+  const J m2 = xn * xn + xe * xe;
+  const J m = sqrt(m2);
+  return (xn * xee - xe * xnn) / (m2 * m);
+}
+
 // 4-point Gauss-Legendre on [-1, 1].
 constexpr double kGlX[4] = {-0.86113631159405257522, -0.33998104358485626480,
                             0.33998104358485626480, 0.86113631159405257522};
@@ -36,6 +44,34 @@ constexpr double kGlW[4] = {0.34785484513745385737, 0.65214515486254614263,
                             0.65214515486254614263, 0.34785484513745385737};
 
 std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+/// The smoothed path of a polyline as PathScenario drives it: knots at the cumulative chord
+/// lengths (vertices closer than 1e-6 m to the last kept one dropped), extended beyond its ends
+/// along its first and last chords. Empty knots if the polyline has no length.
+GaussPolyline<2> smoothed_path(const std::vector<std::array<double, 2>>& pts, double sigma) {
+  std::vector<double> u{0.0};
+  std::vector<std::array<double, 2>> p{pts[0]};
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const double d = std::hypot(pts[i][0] - p.back()[0], pts[i][1] - p.back()[1]);
+    if (d < 1e-6) continue;
+    u.push_back(u.back() + d);
+    p.push_back(pts[i]);
+  }
+  if (u.size() < 2) return {};
+  const std::size_t n = u.size();
+  std::array<double, 2> t0{(p[1][0] - p[0][0]) / (u[1] - u[0]), (p[1][1] - p[0][1]) / (u[1] - u[0])};
+  std::array<double, 2> t1{(p[n - 1][0] - p[n - 2][0]) / (u[n - 1] - u[n - 2]),
+                           (p[n - 1][1] - p[n - 2][1]) / (u[n - 1] - u[n - 2])};
+  return GaussPolyline<2>(u, p, sigma, t0, t1);
+}
+
+/// The curvature of a smoothed path at u (positive turning right).
+double smoothed_curvature(const GaussPolyline<2>& path, double u) {
+  std::array<double, 2> d[3];
+  path.eval(u, 2, d);
+  const double m = std::hypot(d[1][0], d[1][1]);
+  return (d[1][0] * d[2][1] - d[1][1] * d[2][0]) / (m * m * m);
+}
 
 }  // namespace
 
@@ -95,20 +131,8 @@ Terrain Terrain::gentle(double max_slope_deg, std::uint64_t seed) {
 PathScenario::PathScenario(PathScenarioSpec spec) : spec_(std::move(spec)) {
   const auto& pts = spec_.path_ne;
   if (pts.size() < 2) throw InputError("scenario '" + spec_.name + "': the path needs at least two points");
-  std::vector<double> u{0.0};
-  std::vector<std::array<double, 2>> p{pts[0]};
-  for (std::size_t i = 1; i < pts.size(); ++i) {
-    const double d = std::hypot(pts[i][0] - p.back()[0], pts[i][1] - p.back()[1]);
-    if (d < 1e-6) continue;
-    u.push_back(u.back() + d);
-    p.push_back(pts[i]);
-  }
-  if (u.size() < 2) throw InputError("scenario '" + spec_.name + "': the path has no length");
-  const std::size_t n = u.size();
-  std::array<double, 2> t0{(p[1][0] - p[0][0]) / (u[1] - u[0]), (p[1][1] - p[0][1]) / (u[1] - u[0])};
-  std::array<double, 2> t1{(p[n - 1][0] - p[n - 2][0]) / (u[n - 1] - u[n - 2]),
-                           (p[n - 1][1] - p[n - 2][1]) / (u[n - 1] - u[n - 2])};
-  path_ = GaussPolyline<2>(u, p, spec_.path_sigma, t0, t1);
+  path_ = smoothed_path(pts, spec_.path_sigma);
+  if (path_.knots().size() < 2) throw InputError("scenario '" + spec_.name + "': the path has no length");
 
   std::vector<std::array<double, 1>> pu;
   for (double x : spec_.profile_u) pu.push_back({x});
@@ -153,9 +177,8 @@ void PathScenario::evaluate(double t, JV& p_inN, JM& C_VtoN) const {
   J heading = atan2(xe, xn);
   if (spec_.skid_coeff != 0.0) {
     const J xnn = comp(2, 0), xee = comp(2, 1);  // d2p/du2
-    const J m2 = xn * xn + xe * xe;
-    const J m = sqrt(m2);
-    const J kappa = (xn * xee - xe * xnn) / (m2 * m);
+    const J m = sqrt(xn * xn + xe * xe);
+    const J kappa = horizontal_curvature(xn, xe, xnn, xee);
     const J speed = m * udot;
     // v_y = -skid * speed^2 * kappa  <=>  heading = course + atan(skid * speed * kappa)
     heading += atan(spec_.skid_coeff * speed * kappa);
@@ -186,6 +209,21 @@ void PathScenario::evaluate(double t, JV& p_inN, JM& C_VtoN) const {
   const JV y = cross(z, x);
   C_VtoN = JM::from_columns(x, y, z);
 }
+
+J PathScenario::path_curvature(double t) const {
+  // kappa(u(t)): the curvature's u-derivatives from the path's, composed with u(t).
+  const J u = arc(t);
+  std::array<double, 2> pd[kOrder + 3];
+  path_.eval(u.value(), kOrder + 2, pd);
+  double f[kOrder + 1];
+  auto comp = [&](int first, int dim) {
+    for (int k = 0; k <= kOrder; ++k) f[k] = pd[first + k][dim];
+    return compose(f, u);
+  };
+  return horizontal_curvature(comp(1, 0), comp(1, 1), comp(2, 0), comp(2, 1));
+}
+
+double PathScenario::curvature_at(double u) const { return smoothed_curvature(path_, u); }
 
 std::string PathScenario::describe() const {
   std::ostringstream os;
