@@ -231,8 +231,8 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
   static const std::set<std::string> known = {
       "seed", "profile", "effects", "scenario", "speed_file", "duration_s", "rate_hz", "chips",
       "gps_week", "earth_rotation", "start_time_s", "origin", "static_s", "laps", "speed_m_s",
-      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "vehicle", "errors",
-      "faults"};
+      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "start_steering_deg",
+      "vehicle", "errors", "faults"};
   for (const auto& kv : node) {
     const auto k = kv.first.as<std::string>();
     if (!known.count(k)) throw InputError(where + ": unknown key '" + k + "'");
@@ -292,6 +292,8 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
     opt_double("speed_sigma_s", speed_sigma);
     if (node["terrain_slope_deg"])
       terrain_slope_deg = get_double(node["terrain_slope_deg"], key("terrain_slope_deg"));
+    if (node["start_steering_deg"])
+      start_steering_deg = get_double(node["start_steering_deg"], key("start_steering_deg"));
     if (const auto& v = node["vehicle"]) {
       static const std::set<std::string> vk = {"preset", "wheel_radius_m", "track_m", "wheelbase_m",
                                                "left-wheel", "right-wheel", "body", "front-left-wheel",
@@ -397,6 +399,14 @@ void SimConfig::validate() const {
       throw InputError("simulator setting vehicle." + f.group +
                        ".position_m: a steered wheel's x is its distance ahead of the rear axle (o): "
                        "at least 0.5 m, got " + human(f.p_inV.x(), kSi));
+  check(start_steering_deg, -40.0, 40.0, "start_steering_deg", "--start-steering-deg", "deg");
+  if (start_steering_deg != 0.0 && !(vehicle.wheelbase > 0.0))
+    throw InputError("simulator setting start_steering_deg (--start-steering-deg): the arc's curvature is "
+                     "tan(angle) / wheelbase: needs vehicle.wheelbase_m (preset car-steered, or --set "
+                     "vehicle.wheelbase_m=M)");
+  if (start_steering_deg != 0.0 && scenario != "default")
+    throw InputError("simulator setting start_steering_deg (--start-steering-deg): only with the default "
+                     "scenario, not '" + scenario + "'");
   if (loop_scale) check(*loop_scale, 0.01, 100.0, "loop_scale", "", "");
   if (path_sigma) check(*path_sigma, 0.0, 100.0, "path_sigma_m", "", "m");
   if (speed_sigma) check(*speed_sigma, 0.0, 100.0, "speed_sigma_s", "", "s");
@@ -485,6 +495,7 @@ std::string SimConfig::to_yaml() const {
   o << "path_sigma_m: " << (path_sigma ? human(*path_sigma, kSi) : std::string("null")) << "\n";
   o << "speed_sigma_s: " << (speed_sigma ? human(*speed_sigma, kSi) : std::string("null")) << "\n";
   o << "terrain_slope_deg: " << human(terrain_slope_deg, kSi) << "\n";
+  if (start_steering_deg != 0.0) o << "start_steering_deg: " << human(start_steering_deg, kSi) << "\n";
   o << "vehicle:\n";
   o << "  preset: " << vehicle.preset << "\n";
   o << "  wheel_radius_m: " << human(vehicle.wheel_radius, kSi) << "\n";

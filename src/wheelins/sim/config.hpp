@@ -108,7 +108,8 @@ struct VehicleConfig {
   std::string preset = "robot";
   double wheel_radius = 0.097;  ///< nominal [m]
   double track = 0.33;          ///< [m]
-  /// Rear to front axle [m]; 0: not stated (robot, car). The steered wheels' x follows it.
+  /// Rear to front axle [m]; 0: not stated (robot, car). The steered wheels' x and the arc of
+  /// a start with the wheels turned (SimConfig::start_steering_deg) follow it.
   double wheelbase = 0.0;
   ModuleGeometry left, right, body;
   /// The steered front wheels (car-steered: front-left-wheel, front-right-wheel), else empty.
@@ -148,6 +149,10 @@ struct SimConfig {
   std::optional<double> path_sigma;     ///< default: 2.0 m (default scenario), 0.7 m (files)
   std::optional<double> speed_sigma;    ///< default: 1.2 s / 0.5 s
   double terrain_slope_deg = 0.0;       ///< 0: flat
+  /// A start with the wheels turned: the vehicle starts at rest on an arc of curvature
+  /// tan(D) / wheelbase (positive D: a right turn), so the Ackermann angle of the front axle's
+  /// centre is D [deg]; 0: the scenario as without it (default scenario only).
+  double start_steering_deg = 0.0;
   std::optional<double> start_time;     ///< default 100000.0 (ignored with a speed file)
   std::optional<earth::Geodetic> origin;
   /// Sensor-fault events (sim/faults.hpp), in the order given; times in seconds since the

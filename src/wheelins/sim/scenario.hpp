@@ -130,6 +130,11 @@ struct DefaultScenarioOptions {
   double scale = 1.0;          ///< size of the T (1: 254 m per lap)
   double skid_coeff = 0.0;
   Terrain terrain;
+  /// A start with the wheels turned [1/m] (0: none): o starts at rest on an arc whose
+  /// smoothed path has exactly this curvature at the start (positive: turning right), drives
+  /// along it (a quarter turn, at most max(20 m, 3 path sigmas), at least 5 m of driving + 2 sigmas) and
+  /// joins the T where the lap starts, along its first side.
+  double start_curvature = 0.0;
 };
 PathScenarioSpec default_scenario_spec(const DefaultScenarioOptions& opt);
 

@@ -66,6 +66,9 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     o.stops = cfg_.stops;
     o.skid_coeff = skid;
     o.terrain = terrain;
+    // The front axle's centre (wheelbase, 0) turned by D: kappa = tan(D) / wheelbase.
+    if (cfg_.start_steering_deg != 0.0)
+      o.start_curvature = std::tan(cfg_.start_steering_deg * kDeg) / cfg_.vehicle.wheelbase;
     scenario_ = std::make_unique<PathScenario>(default_scenario_spec(o));
   } else {
     PathFileOptions o;
