@@ -28,7 +28,7 @@ struct Options {
   bool quiet = false;
   std::vector<std::string> disable, only, settings, faults;
   std::string config;
-  std::optional<double> radius, track, rate, terrain, static_s, speed, wheel_noise;
+  std::optional<double> radius, track, rate, terrain, static_s, speed, wheel_noise, start_steering;
   std::optional<int> laps, chips;
   bool no_earth_rotation = false;
   bool no_ideal = false;
@@ -75,6 +75,7 @@ int run(const Options& o) {
   if (o.track) cfg.apply_setting("vehicle.track_m=" + std::to_string(*o.track));
   if (o.speed) cfg.speed = *o.speed;
   if (o.terrain) cfg.terrain_slope_deg = *o.terrain;
+  if (o.start_steering) cfg.start_steering_deg = *o.start_steering;
   if (o.static_s) cfg.static_duration = *o.static_s;
   if (o.no_earth_rotation) cfg.earth_rotation = false;
   if (o.no_ideal) cfg.write_ideal = false;
@@ -131,7 +132,9 @@ const bool registered = wheelins::cli::register_command(
                      "default (T-shaped loop, 5 laps) or a path file: .kml (<LineString>) or .csv")
           ->capture_default_str();
       sub.add_option("--speed", o->speed_file, "odo.bin (t, speed) timing the path (with a path file)");
-      sub.add_option("--preset", o->preset, "vehicle preset: robot (default) or car");
+      sub.add_option("--preset", o->preset,
+                     "vehicle preset: robot (default), car, or car-steered (the car with two more "
+                     "Wheel-IMUs on its steered front wheels)");
       sub.add_option("--profile", o->profile, "error profile: field (default), datasheet or ideal");
       sub.add_option("--seed", o->seed, "random seed (default 1)");
       sub.add_option("--duration", o->duration, "seconds from the start (default: whole scenario)");
@@ -151,6 +154,10 @@ const bool registered = wheelins::cli::register_command(
       sub.add_option("--cruise-speed", o->speed, "cruise speed [m/s] (default scenario / path without odo)");
       sub.add_option("--terrain", o->terrain, "smooth terrain with slopes up to this many degrees (0: flat)");
       sub.add_option("--static", o->static_s, "static period at the start [s] (default 30)");
+      sub.add_option("--start-steering-deg", o->start_steering,
+                     "start at rest on an arc that turns the front axle's centre by this many degrees "
+                     "(positive: right; curvature tan(D) / vehicle.wheelbase_m), then join the default "
+                     "scenario's loop (default 0: no arc)");
       sub.add_option("--wheel-noise", o->wheel_noise,
                      "white noise on the Wheel-IMU accelerometers from rolling [m/s/sqrt(h)] at the "
                      "cruise speed (effect wheel_noise; none at rest unless errors.wheel_accel_noise_rest)");

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "wheelins/nav/mechanization.hpp"
 #include "wheelins/sim/simulator.hpp"
@@ -191,6 +192,27 @@ TEST(SimPhysics, WheelGyroGivesWheelCentreSpeed) {
   }
 }
 
+namespace {
+/// Module g's jets against fourth-order central differences of its truth at `times` [s since
+/// the start] (the vibration reaches 60 Hz).
+void check_jets_against_differences(const Simulation& sim, int g, const std::vector<double>& times) {
+  const double h = 2e-5;
+  for (double dt : times) {
+    const double t = sim.start_time() + dt;
+    const ImuTruth m2 = sim.truth(g, t - 2 * h), m = sim.truth(g, t - h), c = sim.truth(g, t),
+                   p = sim.truth(g, t + h), p2 = sim.truth(g, t + 2 * h);
+    const Vec3 v_fd = (-p2.p_inN + 8.0 * p.p_inN - 8.0 * m.p_inN + m2.p_inN) / (12 * h);
+    const Vec3 a_fd = (-p2.v_inN + 8.0 * p.v_inN - 8.0 * m.v_inN + m2.v_inN) / (12 * h);
+    // Angular rate from the attitude: log(C(t-h)^T C(t+h)) / 2h.
+    const Vec3 w_fd = rotvec_from_quat(Quat(m.C_StoN.transpose() * p.C_StoN)) / (2 * h);
+    EXPECT_LT((v_fd - c.v_inN).norm(), 1e-7) << "group " << g << " t " << dt;
+    EXPECT_LT((a_fd - c.a_inN).norm(), 1e-6 * std::max(1.0, c.a_inN.norm())) << "group " << g << " t " << dt;
+    EXPECT_LT((w_fd - c.omega_nb_inS).norm(), 1e-5 * std::max(1.0, c.omega_nb_inS.norm()))
+        << "group " << g << " t " << dt;
+  }
+}
+}  // namespace
+
 // The jets' derivatives agree with central differences of the values (validates the
 // chain rule through the path smoothing, the skid, terrain, vibration and the wheel spin).
 TEST(SimPhysics, JetDerivativesMatchCentralDifferences) {
@@ -199,22 +221,36 @@ TEST(SimPhysics, JetDerivativesMatchCentralDifferences) {
   cfg.duration = 120.0;
   cfg.start_time = 0.0;  // times of order 1e5 s would put 1e-11 s rounding into t +- h
   const Simulation sim(cfg);
-  const double h = 2e-5;
-  for (int g = 0; g < 3; ++g) {
-    for (double dt : {45.3, 71.9, 96.2}) {
-      const double t = sim.start_time() + dt;
-      const ImuTruth m2 = sim.truth(g, t - 2 * h), m = sim.truth(g, t - h), c = sim.truth(g, t),
-                     p = sim.truth(g, t + h), p2 = sim.truth(g, t + 2 * h);
-      // Fourth-order central differences (the vibration reaches 60 Hz).
-      const Vec3 v_fd = (-p2.p_inN + 8.0 * p.p_inN - 8.0 * m.p_inN + m2.p_inN) / (12 * h);
-      const Vec3 a_fd = (-p2.v_inN + 8.0 * p.v_inN - 8.0 * m.v_inN + m2.v_inN) / (12 * h);
-      // Angular rate from the attitude: log(C(t-h)^T C(t+h)) / 2h.
-      const Vec3 w_fd = rotvec_from_quat(Quat(m.C_StoN.transpose() * p.C_StoN)) / (2 * h);
-      EXPECT_LT((v_fd - c.v_inN).norm(), 1e-7) << "group " << g << " t " << dt;
-      EXPECT_LT((a_fd - c.a_inN).norm(), 1e-6 * std::max(1.0, c.a_inN.norm())) << "group " << g;
-      EXPECT_LT((w_fd - c.omega_nb_inS).norm(), 1e-5 * std::max(1.0, c.omega_nb_inS.norm())) << "group " << g;
-    }
+  for (int g = 0; g < 3; ++g) check_jets_against_differences(sim, g, {45.3, 71.9, 96.2});
+}
+
+// The same for the steered front wheels of car-steered (and the others of that preset): the
+// steering angle's jet (Ackermann of the path's curvature) in the attitude and the rolling
+// rate; in the sharpest turns, while the steering turns and at rest with the wheels turned.
+TEST(SimPhysics, JetDerivativesMatchCentralDifferencesOnSteeredWheels) {
+  SimConfig cfg;  // field: vibration, slip, skid on
+  cfg.vehicle = VehicleConfig::preset_named("car-steered");
+  cfg.terrain_slope_deg = 3.0;
+  cfg.duration = 90.0;
+  cfg.static_duration = 5.0;
+  cfg.start_time = 0.0;
+  cfg.start_steering_deg = 25.0;
+  const Simulation sim(cfg);
+  ASSERT_EQ(sim.groups(), 5);
+  // The sharpest turn and the fastest steering in the first corners of the T (after the
+  // start's arc).
+  double t_kappa = 0.0, t_rate = 0.0, best_kappa = 0.0, best_rate = 0.0;
+  for (double t = 35.0; t < 90.0; t += 0.1) {
+    const J k = sim.scenario().path_curvature(t);
+    if (std::abs(k.value()) > best_kappa) best_kappa = std::abs(k.value()), t_kappa = t;
+    if (std::abs(k.deriv(1)) > best_rate) best_rate = std::abs(k.deriv(1)), t_rate = t;
   }
+  const ImuTruth r = sim.truth(4, t_rate);
+  std::printf("steered jets: curvature %.3f 1/m at %.1f s, steering rate %.1f deg/s at %.1f s\n", best_kappa,
+              t_kappa, r.steering_rate / kDeg, t_rate);
+  EXPECT_GT(std::abs(r.steering_rate), 5.0 * kDeg);
+  // At rest with the wheels turned, driving off along the start's arc, in the turns.
+  for (int g : {0, 2, 3, 4}) check_jets_against_differences(sim, g, {3.0, 21.7, t_kappa, t_rate});
 }
 
 // The vehicle is at rest during the static period and the default scenario is the

@@ -143,6 +143,7 @@ VehicleConfig VehicleConfig::preset_named(const std::string& name) {
   v.right.group = "right-wheel";
   v.body.group = "body";
   v.body.wheel = false;
+  const bool steered = name == "car-steered";
   if (name == "robot") {
     // Pioneer 3DX-like: the Wheel-INS dataset's radius, lever arm and rate.
     v.wheel_radius = 0.097;
@@ -153,7 +154,7 @@ VehicleConfig VehicleConfig::preset_named(const std::string& name) {
     v.right.mounting_rpy = Vec3(0.0, -0.5, 0.4) * kDeg;
     v.body.p_inV = Vec3(0.12, 0.03, -0.22);
     v.body.mounting_rpy = Vec3(0.4, -0.6, 1.2) * kDeg;
-  } else if (name == "car") {
+  } else if (name == "car" || steered) {
     v.wheel_radius = 0.35;
     v.track = 1.6;
     v.left.lever_arm_inB = Vec3(0.02, 0.004, -0.003);
@@ -163,11 +164,38 @@ VehicleConfig VehicleConfig::preset_named(const std::string& name) {
     v.body.p_inV = Vec3(1.3, 0.1, -0.5);
     v.body.mounting_rpy = Vec3(0.5, -0.3, 0.8) * kDeg;
   } else {
-    throw InputError("unknown vehicle preset '" + name + "' (expected robot or car)");
+    throw InputError("unknown vehicle preset '" + name + "' (expected robot, car or car-steered)");
   }
   v.left.p_inV = Vec3(0.0, -0.5 * v.track, 0.0);
   v.right.p_inV = Vec3(0.0, 0.5 * v.track, 0.0);
+  if (steered) {
+    // The car with two Wheel-IMUs on its steered front wheels, the same chips as the rear ones.
+    v.wheelbase = 2.6;
+    ModuleGeometry fl, fr;
+    fl.group = "front-left-wheel";
+    fr.group = "front-right-wheel";
+    fl.steered = fr.steered = true;
+    fl.lever_arm_inB = Vec3(0.02, -0.003, 0.004);
+    fr.lever_arm_inB = Vec3(-0.02, 0.004, -0.003);
+    fl.mounting_rpy = Vec3(0.0, 0.4, -0.6) * kDeg;
+    fr.mounting_rpy = Vec3(0.0, -0.5, 0.5) * kDeg;
+    fl.p_inV = Vec3(v.wheelbase, -0.5 * v.track, 0.0);
+    fr.p_inV = Vec3(v.wheelbase, 0.5 * v.track, 0.0);
+    v.front = {fl, fr};
+  }
   return v;
+}
+
+std::vector<const ModuleGeometry*> VehicleConfig::modules() const {
+  std::vector<const ModuleGeometry*> r = {&left, &right, &body};
+  for (const ModuleGeometry& f : front) r.push_back(&f);
+  return r;
+}
+
+std::vector<ModuleGeometry*> VehicleConfig::mutable_modules() {
+  std::vector<ModuleGeometry*> r = {&left, &right, &body};
+  for (ModuleGeometry& f : front) r.push_back(&f);
+  return r;
 }
 
 ErrorParams profile_errors(const std::string& profile) {
@@ -203,8 +231,8 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
   static const std::set<std::string> known = {
       "seed", "profile", "effects", "scenario", "speed_file", "duration_s", "rate_hz", "chips",
       "gps_week", "earth_rotation", "start_time_s", "origin", "static_s", "laps", "speed_m_s",
-      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "vehicle", "errors",
-      "faults"};
+      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "start_steering_deg",
+      "vehicle", "errors", "faults"};
   for (const auto& kv : node) {
     const auto k = kv.first.as<std::string>();
     if (!known.count(k)) throw InputError(where + ": unknown key '" + k + "'");
@@ -264,19 +292,31 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
     opt_double("speed_sigma_s", speed_sigma);
     if (node["terrain_slope_deg"])
       terrain_slope_deg = get_double(node["terrain_slope_deg"], key("terrain_slope_deg"));
+    if (node["start_steering_deg"])
+      start_steering_deg = get_double(node["start_steering_deg"], key("start_steering_deg"));
     if (const auto& v = node["vehicle"]) {
-      static const std::set<std::string> vk = {"preset", "wheel_radius_m", "track_m", "left-wheel",
-                                               "right-wheel", "body"};
+      static const std::set<std::string> vk = {"preset", "wheel_radius_m", "track_m", "wheelbase_m",
+                                               "left-wheel", "right-wheel", "body", "front-left-wheel",
+                                               "front-right-wheel"};
       for (const auto& kv : v)
         if (!vk.count(kv.first.as<std::string>()))
           throw InputError(key("vehicle") + ": unknown key '" + kv.first.as<std::string>() + "'");
+      for (const char* f : {"front-left-wheel", "front-right-wheel"})
+        if (v[f] && vehicle.front.empty())
+          throw InputError(key(std::string("vehicle.") + f) + ": the vehicle preset '" + vehicle.preset +
+                           "' has no such module (preset car-steered has)");
       if (v["wheel_radius_m"]) vehicle.wheel_radius = get_double(v["wheel_radius_m"], key("vehicle.wheel_radius_m"));
       if (v["track_m"]) {
         vehicle.track = get_double(v["track_m"], key("vehicle.track_m"));
         vehicle.left.p_inV.y() = -0.5 * vehicle.track;
         vehicle.right.p_inV.y() = 0.5 * vehicle.track;
+        for (ModuleGeometry& f : vehicle.front) f.p_inV.y() = (f.p_inV.y() < 0.0 ? -0.5 : 0.5) * vehicle.track;
       }
-      for (ModuleGeometry* m : {&vehicle.left, &vehicle.right, &vehicle.body}) {
+      if (v["wheelbase_m"]) {
+        vehicle.wheelbase = get_double(v["wheelbase_m"], key("vehicle.wheelbase_m"));
+        for (ModuleGeometry& f : vehicle.front) f.p_inV.x() = vehicle.wheelbase;
+      }
+      for (ModuleGeometry* m : vehicle.mutable_modules()) {
         const auto& mn = v[m->group];
         if (!mn) continue;
         const std::string w = key("vehicle." + m->group);
@@ -351,6 +391,22 @@ void SimConfig::validate() const {
   check(terrain_slope_deg, 0.0, 30.0, "terrain_slope_deg", "--terrain", "deg");
   check(vehicle.wheel_radius, 0.01, 2.0, "vehicle.wheel_radius_m", "--radius", "m");
   check(vehicle.track, 0.05, 10.0, "vehicle.track_m", "--track", "m");
+  // A steered wheel is ahead of the rear axle: the vehicle needs a wheelbase (0: none stated).
+  if (!vehicle.front.empty() || vehicle.wheelbase != 0.0)
+    check(vehicle.wheelbase, 0.5, 20.0, "vehicle.wheelbase_m", "", "m");
+  for (const ModuleGeometry& f : vehicle.front)
+    if (!(f.p_inV.x() >= 0.5))
+      throw InputError("simulator setting vehicle." + f.group +
+                       ".position_m: a steered wheel's x is its distance ahead of the rear axle (o): "
+                       "at least 0.5 m, got " + human(f.p_inV.x(), kSi));
+  check(start_steering_deg, -40.0, 40.0, "start_steering_deg", "--start-steering-deg", "deg");
+  if (start_steering_deg != 0.0 && !(vehicle.wheelbase > 0.0))
+    throw InputError("simulator setting start_steering_deg (--start-steering-deg): the arc's curvature is "
+                     "tan(angle) / wheelbase: needs vehicle.wheelbase_m (preset car-steered, or --set "
+                     "vehicle.wheelbase_m=M)");
+  if (start_steering_deg != 0.0 && scenario != "default")
+    throw InputError("simulator setting start_steering_deg (--start-steering-deg): only with the default "
+                     "scenario, not '" + scenario + "'");
   if (loop_scale) check(*loop_scale, 0.01, 100.0, "loop_scale", "", "");
   if (path_sigma) check(*path_sigma, 0.0, 100.0, "path_sigma_m", "", "m");
   if (speed_sigma) check(*speed_sigma, 0.0, 100.0, "speed_sigma_s", "", "s");
@@ -439,11 +495,13 @@ std::string SimConfig::to_yaml() const {
   o << "path_sigma_m: " << (path_sigma ? human(*path_sigma, kSi) : std::string("null")) << "\n";
   o << "speed_sigma_s: " << (speed_sigma ? human(*speed_sigma, kSi) : std::string("null")) << "\n";
   o << "terrain_slope_deg: " << human(terrain_slope_deg, kSi) << "\n";
+  if (start_steering_deg != 0.0) o << "start_steering_deg: " << human(start_steering_deg, kSi) << "\n";
   o << "vehicle:\n";
   o << "  preset: " << vehicle.preset << "\n";
   o << "  wheel_radius_m: " << human(vehicle.wheel_radius, kSi) << "\n";
   o << "  track_m: " << human(vehicle.track, kSi) << "\n";
-  for (const ModuleGeometry* m : {&vehicle.left, &vehicle.right, &vehicle.body}) {
+  if (vehicle.wheelbase != 0.0) o << "  wheelbase_m: " << human(vehicle.wheelbase, kSi) << "\n";
+  for (const ModuleGeometry* m : vehicle.modules()) {
     o << "  " << m->group << ":\n";
     o << "    position_m: " << vec_text(m->p_inV, kSi) << "\n";
     if (m->wheel) o << "    lever_arm_m: " << vec_text(m->lever_arm_inB, kSi) << "\n";

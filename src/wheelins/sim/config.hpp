@@ -93,8 +93,12 @@ ErrorParams profile_errors(const std::string& profile);
 
 /// One physical module (a group of four chips).
 struct ModuleGeometry {
-  std::string group;            ///< "left-wheel", "right-wheel", "body"
+  std::string group;            ///< "left-wheel", "right-wheel", "body", "front-left-wheel", ...
   bool wheel = true;
+  /// A steered wheel (preset car-steered): it turns about the vehicle's z through its centre
+  /// by the Ackermann angle of the path's curvature (docs/simulator.md); p_inV.x is its distance
+  /// ahead of o, the mid rear axle.
+  bool steered = false;
   Vec3 p_inV = Vec3::Zero();    ///< wheel centre (wheel) / IMU centre (body) [m]
   Vec3 lever_arm_inB = Vec3::Zero();  ///< wheel: IMU centre -> wheel centre, b-frame [m]
   Vec3 mounting_rpy = Vec3::Zero();   ///< wheel: C_s^b; body: C_b^v (ZYX Euler) [rad]
@@ -104,9 +108,20 @@ struct VehicleConfig {
   std::string preset = "robot";
   double wheel_radius = 0.097;  ///< nominal [m]
   double track = 0.33;          ///< [m]
+  /// Rear to front axle [m]; 0: not stated (robot, car). The steered wheels' x and the arc of
+  /// a start with the wheels turned (SimConfig::start_steering_deg) follow it.
+  double wheelbase = 0.0;
   ModuleGeometry left, right, body;
-  /// Wheel centres at (0, -/+ track/2, 0) unless overridden.
+  /// The steered front wheels (car-steered: front-left-wheel, front-right-wheel), else empty.
+  std::vector<ModuleGeometry> front;
+  /// Wheel centres at (0, -/+ track/2, 0) (front wheels: (wheelbase, -/+ track/2, 0)) unless
+  /// overridden. Presets: robot, car, car-steered (the car with two steered front Wheel-IMUs).
   static VehicleConfig preset_named(const std::string& name);
+  /// Every module in group order: left, right, body, then the front wheels.
+  std::vector<const ModuleGeometry*> modules() const;
+  std::vector<ModuleGeometry*> mutable_modules();
+  /// The car's scenario defaults (speed, size, smoothing) apply: presets car and car-steered.
+  bool car() const { return preset == "car" || preset == "car-steered"; }
 };
 
 struct SimConfig {
@@ -134,6 +149,10 @@ struct SimConfig {
   std::optional<double> path_sigma;     ///< default: 2.0 m (default scenario), 0.7 m (files)
   std::optional<double> speed_sigma;    ///< default: 1.2 s / 0.5 s
   double terrain_slope_deg = 0.0;       ///< 0: flat
+  /// A start with the wheels turned: the vehicle starts at rest on an arc of curvature
+  /// tan(D) / wheelbase (positive D: a right turn), so the Ackermann angle of the front axle's
+  /// centre is D [deg]; 0: the scenario as without it (default scenario only).
+  double start_steering_deg = 0.0;
   std::optional<double> start_time;     ///< default 100000.0 (ignored with a speed file)
   std::optional<earth::Geodetic> origin;
   /// Sensor-fault events (sim/faults.hpp), in the order given; times in seconds since the

@@ -59,6 +59,7 @@ ModuleSpec module_spec(const ModuleGeometry& geo, double radius, const std::stri
   s.mounting_rpy = geo.mounting_rpy;
   s.axle_sign = 1;
   s.wheel_radius = geo.wheel ? radius : 0.0;
+  s.steered = geo.wheel && geo.steered;
   s.gyro_range = gyro_range;
   s.noise = datasheet_noise();
   return s;
@@ -69,10 +70,10 @@ Manifest Simulation::manifest() const {
   Manifest m = ideal_manifest();
   m.name = "wheelins simulate (" + cfg_.profile + ", seed " + std::to_string(cfg_.seed) + ")";
   m.modules.clear();
-  for (int g = 0; g < kGroups; ++g) {
+  for (int g = 0; g < groups(); ++g) {
     const ModuleModel& mm = modules_[g];
     for (const ChipModel& ch : chips_[g]) {
-      const std::string chip = ch.name.substr(ch.name.find('-') + 1);
+      const std::string chip = ch.name.substr(ch.name.rfind('-') + 1);
       m.modules.push_back(module_spec(mm.manifest, mm.radius_manifest, ch.name, group_name(g), chip,
                                       fs::path(group_dir(g)) / ("tri_" + chip + "_imu.bin"),
                                       cfg_.rate_hz, gyro_range()));
@@ -95,10 +96,11 @@ Manifest Simulation::ideal_manifest() const {
   m.gravity = gravity_;
   m.earth_rotation = cfg_.earth_rotation;
   m.track_width = cfg_.vehicle.track;
-  for (int g = 0; g < kGroups; ++g) {
+  m.wheelbase = cfg_.vehicle.wheelbase;
+  for (int g = 0; g < groups(); ++g) {
     const ModuleModel& mm = modules_[g];
     m.modules.push_back(module_spec(
-        mm.truth, mm.radius, std::string(g == 0 ? "left" : g == 1 ? "right" : "body") + "-ideal",
+        mm.truth, mm.radius, std::string(chip_prefix(g)) + "-ideal",
         group_name(g), "ideal", fs::path("ideal") / (std::string(group_name(g)) + "_imu.bin"),
         cfg_.rate_hz, gyro_range()));
   }
@@ -124,7 +126,7 @@ std::string Simulation::errors_yaml() const {
   o << "]\n";
   if (speed_scale_ != 1.0) o << "speed_profile_scale: " << num(speed_scale_) << "  # odometer speed scaled to the path length\n";
   o << "modules:\n";
-  for (int g = 0; g < kGroups; ++g) {
+  for (int g = 0; g < groups(); ++g) {
     const ModuleModel& m = modules_[g];
     o << "  " << group_name(g) << ":\n";
     if (m.truth.wheel) {
@@ -181,17 +183,17 @@ std::string Simulation::errors_yaml() const {
   }
   o << "faults:  # times since the start of the data " << num(start_time())
     << " s; sensor faults act on the samples stamped in [start, end)\n";
-  int slip_index[2] = {0, 0};
+  std::vector<std::size_t> slip_index(modules_.size(), 0);
   for (const FaultEvent& f : cfg_.faults) {
     o << "  - spec: \"" << f.spec() << "\"\n";
     std::string chips;
-    for (int g = 0; g < kGroups; ++g)
+    for (int g = 0; g < groups(); ++g)
       for (const ChipModel& c : chips_[g])
         if (f.targets(group_name(g), c.name)) chips += (chips.empty() ? "" : ", ") + c.name;
     o << "    chips: [" << chips << "]\n";
     const std::string end = f.end ? num(start_time() + *f.end) : std::string("end");
     if (f.kind == FaultKind::kSlip) {
-      const int g = f.target == "left-wheel" ? 0 : 1;
+      const int g = group_index(f.target);
       const ModuleModel::SlipEvent& e = modules_[g].slip_events[slip_index[g]++];
       const double ramp = std::isfinite(e.t1) ? std::min(kSlipRamp, 0.5 * (e.t1 - e.t0)) : kSlipRamp;
       o << "    true_time_s: [" << num(e.t0) << ", " << end << "]  # also the error-free stream "
@@ -238,7 +240,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
   }
   fs::create_directories(dir, ec);
   if (ec) throw InputError("'" + dir.string() + "': cannot create: " + ec.message());
-  for (int g = 0; g < kGroups; ++g) fs::create_directories(dir / group_dir(g));
+  for (int g = 0; g < groups(); ++g) fs::create_directories(dir / group_dir(g));
   if (cfg_.write_ideal) fs::create_directories(dir / "ideal");
   fs::create_directories(dir / "errors");
 
@@ -251,7 +253,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
 
   std::atomic<std::uint64_t> done{0};
   std::atomic<int> finished{0};
-  std::exception_ptr errors[kGroups];
+  std::exception_ptr errors[kMaxGroups];
   auto worker = [&](int g) {
     try {
       const ModuleModel& m = modules_[g];
@@ -266,7 +268,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
       std::vector<ChipSampler> chips;
       for (const ChipModel& c : chips_[g]) {
         chips.emplace_back(*this, g, c);
-        const std::string chip = c.name.substr(c.name.find('-') + 1);
+        const std::string chip = c.name.substr(c.name.rfind('-') + 1);
         outs.push_back(std::make_unique<BinaryRowWriter>(dir / group_dir(g) / ("tri_" + chip + "_imu.bin"), 7));
         bias_outs.push_back(std::make_unique<BinaryRowWriter>(dir / "errors" / (c.name + "_bias.bin"), 7));
       }
@@ -305,10 +307,10 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
     ++finished;
   };
   std::vector<std::thread> threads;
-  for (int g = 0; g < kGroups; ++g) threads.emplace_back(worker, g);
+  for (int g = 0; g < groups(); ++g) threads.emplace_back(worker, g);
 
   // Truth (200 Hz) and odometer (2 Hz) in this thread.
-  Progress prog("simulate", K * kGroups + K, progress);
+  Progress prog("simulate", K * static_cast<std::uint64_t>(groups()) + K, progress);
   std::exception_ptr main_error;
   try {
     const earth::LocalFrame lf(scenario_->origin());
@@ -332,7 +334,7 @@ DatasetSummary Simulation::write(const fs::path& dir, bool force, bool progress)
     }
     truth.commit();
     odo.commit();
-    while (finished < kGroups) {
+    while (finished < groups()) {
       prog.update(done + K);
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }

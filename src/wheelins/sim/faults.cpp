@@ -34,11 +34,17 @@ std::optional<double> parse_number(const std::string& s) {
   return v;
 }
 
-bool is_group(const std::string& t) { return t == "left-wheel" || t == "right-wheel" || t == "body"; }
+/// The wheel groups (the front ones: preset car-steered; the simulation checks that the
+/// vehicle has the target).
+bool is_wheel_group(const std::string& t) {
+  return t == "left-wheel" || t == "right-wheel" || t == "front-left-wheel" || t == "front-right-wheel";
+}
+bool is_group(const std::string& t) { return is_wheel_group(t) || t == "body"; }
 
-/// "left-C1".."left-C16", "right-C..", "body-C.." (the chip count is checked by the simulation).
+/// "left-C1".."left-C16", "right-C..", "body-C..", "front-left-C..", "front-right-C.." (the chip
+/// count is checked by the simulation).
 bool is_chip(const std::string& t) {
-  for (const char* g : {"left-C", "right-C", "body-C"}) {
+  for (const char* g : {"left-C", "right-C", "body-C", "front-left-C", "front-right-C"}) {
     const std::string p = g;
     if (t.rfind(p, 0) != 0) continue;
     const std::string n = t.substr(p.size());
@@ -84,9 +90,11 @@ FaultEvent build(const RawFault& r, const Fail& fail) {
   if (!is_group(e.target) && !is_chip(e.target))
     throw fail(r.target.label, "unknown target '" + e.target +
                              "' (expected a chip such as left-C1, right-C2, body-C4, or a module group "
-                             "left-wheel, right-wheel or body)");
-  if (e.kind == FaultKind::kSlip && e.target != "left-wheel" && e.target != "right-wheel")
-    throw fail(r.target.label, "slip acts on a wheel: expected left-wheel or right-wheel, got '" + e.target + "'");
+                             "left-wheel, right-wheel or body; preset car-steered also front-left-wheel, "
+                             "front-right-wheel and their chips front-left-C1, ...)");
+  if (e.kind == FaultKind::kSlip && !is_wheel_group(e.target))
+    throw fail(r.target.label, "slip acts on a wheel: expected left-wheel or right-wheel (or a front wheel "
+                               "of preset car-steered), got '" + e.target + "'");
   // Times, in seconds since the start of the data.
   const auto t0 = parse_number(r.start.text);
   if (!t0 || *t0 < 0.0)

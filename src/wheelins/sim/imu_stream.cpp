@@ -8,18 +8,19 @@ namespace {
 /// The group and chip of module `name` of the simulation's manifests; chip -1: the group's
 /// error-free stream.
 std::pair<int, int> find_module(const Simulation& sim, const std::string& name) {
-  for (int g = 0; g < Simulation::kGroups; ++g) {
+  for (int g = 0; g < sim.groups(); ++g) {
     const std::vector<ChipModel>& chips = sim.chips(g);
     for (std::size_t c = 0; c < chips.size(); ++c)
       if (chips[c].name == name) return {g, static_cast<int>(c)};
-    const std::string ideal = std::string(g == 0 ? "left" : g == 1 ? "right" : "body") + "-ideal";
+    const std::string ideal = std::string(Simulation::chip_prefix(g)) + "-ideal";
     if (name == ideal) return {g, -1};
   }
-  std::string known;
-  for (int g = 0; g < Simulation::kGroups; ++g)
+  std::string known, ideal;
+  for (int g = 0; g < sim.groups(); ++g) {
     for (const ChipModel& c : sim.chips(g)) known += (known.empty() ? "" : ", ") + c.name;
-  throw InputError("simulation: no module named '" + name + "' (modules: " + known +
-                   ", and left-ideal, right-ideal, body-ideal)");
+    ideal += (ideal.empty() ? "" : ", ") + std::string(Simulation::chip_prefix(g)) + "-ideal";
+  }
+  throw InputError("simulation: no module named '" + name + "' (modules: " + known + ", and " + ideal + ")");
 }
 
 }  // namespace

@@ -38,9 +38,9 @@ void scale(JV& a, const J& g) {
 /// v_wc the forward speed of the wheel centre, a_wc its derivative (valid to order kOrder - 2
 /// with the slip effect: the top coefficient of a_wc is lost), s_i and w_i the ratio and the
 /// C-infinity window of each slip fault (exact jets in t, sim/faults.hpp).
-J wheel_rate_jet(const ModuleModel& m, double t, const JV& p_o, const JM& C_v) {
+J wheel_rate_jet(const ModuleModel& m, double t, const JV& p_o, const JM& C_v, const J& delta) {
   const JV pwc = p_o + C_v * m.truth.p_inV;
-  const J vf = dot(C_v.col(0), pwc.dot());
+  const J vf = dot(wheel_heading(m, C_v, delta), pwc.dot());
   // The windows vanish with all derivatives outside (t0, t1): there the fault-free
   // expressions below are used, so the data outside the events are bit for bit unchanged.
   J fault(0.0);
@@ -59,10 +59,26 @@ J wheel_rate_jet(const ModuleModel& m, double t, const JV& p_o, const JM& C_v) {
   return vf * (1.0 + m.slip_coeff * af) / m.radius;
 }
 
-/// Forward speed of a wheel centre (rigid motion, no slip) at a time, from the v-frame jets.
-double wheel_centre_speed_of(const ModuleModel& m, const JV& p_o, const JM& C_v) {
+/// Speed of a wheel centre along its heading (rigid motion, no slip), from the v-frame jets.
+double wheel_centre_speed_of(const ModuleModel& m, const JV& p_o, const JM& C_v, const J& delta) {
   const JV pwc = p_o + C_v * m.truth.p_inV;
-  return dot(C_v.col(0), pwc.dot()).value();
+  return dot(wheel_heading(m, C_v, delta), pwc.dot()).value();
+}
+
+J steering_jet(const ModuleModel& m, const J& kappa) {
+  if (!m.truth.steered) return J(0.0);
+  // Ackermann: the wheel's axle points at the centre of the turn, (0, 1/kappa) from o in the
+  // v-frame; its heading is perpendicular to the line from that centre to the hub.
+  const Vec3& h = m.truth.p_inV;
+  return atan2(kappa * h.x(), 1.0 - kappa * h.y());
+}
+
+JV wheel_heading(const ModuleModel& m, const JM& C_v, const J& delta) {
+  if (!m.truth.steered) return C_v.col(0);
+  J s, c;
+  sincos(delta, s, c);
+  const JV x = C_v.col(0), y = C_v.col(1);  // Rz(delta) e_x = (cos, sin, 0) in the v-frame
+  return x * c + y * s;
 }
 
 /// The same gain as a plain number, from the speed of o [m/s].
@@ -76,7 +92,7 @@ double vibration_gain(const ModuleModel& m, double speed) {
 GroupStepper::GroupStepper(const Scenario& scenario, const ModuleModel& m,
                            const StepperClock& clock, double offset)
     : scenario_(scenario), clock_(clock), m_(m), offset_(offset), wheel_(m_.truth.wheel),
-      vib_(m_.vibration), h_(1.0 / clock.rate_hz) {
+      steered_(m_.truth.wheel && m_.truth.steered), vib_(m_.vibration), h_(1.0 / clock.rate_hz) {
   C0_ = wheel_c0();
   C_sb_ = dcm_from_euler(m_.truth.mounting_rpy);
   for (int i = 0; i < 4; ++i) node_offset_[i] = 0.5 * h_ * kGlX[i];
@@ -96,14 +112,15 @@ void GroupStepper::step(double t1, Vec3& gyro, Vec3& accel) {
   const double mid = t1 + offset_ - 0.5 * h;
   JV p_o[4];
   JM C_v[4];
-  J rate[4];
+  J rate[4], delta[4];
   double t[4];
   JV disp[4], rot[4];
   if (!vib_.empty()) vib_.eval4(mid, disp, rot);
   for (int i = 0; i < 4; ++i) {
     t[i] = mid + node_offset_[i];
     scenario_.evaluate(t[i], p_o[i], C_v[i]);
-    if (wheel_) rate[i] = wheel_rate_jet(m_, t[i], p_o[i], C_v[i]);
+    if (steered_) delta[i] = steering_at(t[i]);
+    if (wheel_) rate[i] = wheel_rate_jet(m_, t[i], p_o[i], C_v[i], delta[i]);
     if (!vib_.empty()) {
       const J gain = vibration_gain(m_, p_o[i]);
       scale(disp[i], gain);
@@ -119,7 +136,7 @@ void GroupStepper::step(double t1, Vec3& gyro, Vec3& accel) {
       for (int j = 0; j < 4; ++j) ai += 0.5 * h * kLagrange.A[i][j] * rate[j].value();
       alpha = integrate(ai, rate[i]);
     }
-    const NodeResult r = node(t[i], p_o[i], C_v[i], alpha, vib_.empty() ? nullptr : &disp[i],
+    const NodeResult r = node(t[i], p_o[i], C_v[i], alpha, delta[i], vib_.empty() ? nullptr : &disp[i],
                               vib_.empty() ? nullptr : &rot[i]);
     gyro += 0.5 * kGlW[i] * r.gyro;
     accel += 0.5 * kGlW[i] * r.accel;
@@ -132,7 +149,12 @@ J GroupStepper::rate_at(double t) const {
   JV p;
   JM C;
   scenario_.evaluate(t, p, C);
-  return wheel_rate_jet(m_, t, p, C);
+  return wheel_rate_jet(m_, t, p, C, steering_at(t));
+}
+
+J GroupStepper::steering_at(double t) const {
+  if (!steered_) return J(0.0);
+  return steering_jet(m_, scenario_.path_curvature(t));
 }
 
 J GroupStepper::integrate(double value, const J& rate) {
@@ -141,8 +163,8 @@ J GroupStepper::integrate(double value, const J& rate) {
   return a;
 }
 
-void GroupStepper::imu_jets(double t, const JV& p_o, const JM& C_v, const J& alpha, JV& p,
-                            JM& C_s, const JV* vib_disp, const JV* vib_rot) const {
+void GroupStepper::imu_jets(double t, const JV& p_o, const JM& C_v, const J& alpha, const J& delta,
+                            JV& p, JM& C_s, const JV* vib_disp, const JV* vib_rot) const {
   JV disp(Vec3::Zero()), rot(Vec3::Zero());
   if (vib_disp) {
     disp = *vib_disp;
@@ -156,7 +178,9 @@ void GroupStepper::imu_jets(double t, const JV& p_o, const JM& C_v, const J& alp
   const JV offset_v = JV(m_.truth.p_inV) + disp;
   if (wheel_) {
     const bool vib = vib_disp || !m_.vibration.empty();
-    const JM C_wheel = C0_ * jrot_x(-alpha);
+    // A steered wheel turns by delta about the v-frame's z through its centre: C_v Rz(delta) C0
+    // Rx(-alpha) (the vibration's small rotation, in v-frame axes, comes before the steering).
+    const JM C_wheel = steered_ ? jrot_z(delta) * (C0_ * jrot_x(-alpha)) : C0_ * jrot_x(-alpha);
     const JM C_b = vib ? C_v * (jdcm_from_euler(rot[0], rot[1], rot[2]) * C_wheel)
                        : C_v * C_wheel;  // ideal wheel b-frame
     C_s = C_b * C_sb_;
@@ -172,10 +196,10 @@ void GroupStepper::imu_jets(double t, const JV& p_o, const JM& C_v, const J& alp
 }
 
 GroupStepper::NodeResult GroupStepper::node(double t, const JV& p_o, const JM& C_v, const J& alpha,
-                                            const JV* disp, const JV* rot) const {
+                                            const J& delta, const JV* disp, const JV* rot) const {
   JV p;
   JM C_s;
-  imu_jets(t, p_o, C_v, alpha, p, C_s, disp, rot);
+  imu_jets(t, p_o, C_v, alpha, delta, p, C_s, disp, rot);
   const Mat3 C = C_s.value();
   const Vec3 v = p.deriv(1), acc = p.deriv(2);
   const Vec3 w = clock_.omega_ie;

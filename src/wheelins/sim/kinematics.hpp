@@ -43,7 +43,11 @@ struct ImuTruth {
   Vec3 gyro_inS;       ///< + earth rate: what an ideal gyro reads
   Vec3 accel_inS;      ///< specific force (what an ideal accelerometer reads)
   double wheel_angle = 0.0, wheel_rate = 0.0;  ///< alpha, d alpha/dt (wheel modules)
-  double wheel_centre_speed = 0.0;  ///< forward speed of the wheel centre (rigid motion) [m/s]
+  /// Speed of the wheel centre along the wheel's heading (rigid motion) [m/s].
+  double wheel_centre_speed = 0.0;
+  /// Steered wheels: the steering angle delta (the wheel's heading minus the vehicle's,
+  /// positive turned right) and its rate [rad, rad/s]; 0 for the others.
+  double steering_angle = 0.0, steering_rate = 0.0;
 };
 
 /// What a stepper needs besides the motion: the sample grid and the environment.
@@ -54,11 +58,21 @@ struct StepperClock {
   Vec3 omega_ie = Vec3::Zero();  ///< earth rate in the n-frame (zero if not simulated)
 };
 
+/// The steering angle of a steered wheel as a jet: the exact Ackermann angle of its centre
+/// (x_h, y_h) in the v-frame for the curvature kappa of the path of o (positive turning right),
+///   delta = atan2(kappa x_h, 1 - kappa y_h),
+/// positive = turned right (the wheel's heading minus the vehicle's). Zero for the others.
+J steering_jet(const ModuleModel& m, const J& kappa);
+/// The unit vector of a wheel's heading in the n-frame: C_v Rz(delta) e_x (C_v e_x when not
+/// steered).
+JV wheel_heading(const ModuleModel& m, const JM& C_v, const J& delta);
 /// The forward rolling rate of a wheel, d alpha / dt, as a jet in t (with the slip effect
-/// and the module's slip faults), given the v-frame jets of o at t.
-J wheel_rate_jet(const ModuleModel& m, double t, const JV& p_o, const JM& C_v);
-/// Forward speed of a wheel centre (rigid motion, no slip) from the v-frame jets [m/s].
-double wheel_centre_speed_of(const ModuleModel& m, const JV& p_o, const JM& C_v);
+/// and the module's slip faults), given the v-frame jets of o at t and the steering angle
+/// (steered wheels: the hub's velocity along the wheel's heading rolls it).
+J wheel_rate_jet(const ModuleModel& m, double t, const JV& p_o, const JM& C_v, const J& delta = J(0.0));
+/// Speed of a wheel centre along the wheel's heading (rigid motion, no slip) from the
+/// v-frame jets and the steering angle [m/s].
+double wheel_centre_speed_of(const ModuleModel& m, const JV& p_o, const JM& C_v, const J& delta = J(0.0));
 /// The vibration gain at the speed of o [m/s] (see ModuleModel::vib_cruise_speed).
 double vibration_gain(const ModuleModel& m, double speed);
 
@@ -75,24 +89,28 @@ class GroupStepper {
 
   /// The wheel's rolling rate at true time t.
   J rate_at(double t) const;
+  /// The steering angle at true time t (steering_jet of the scenario's path curvature; zero
+  /// unless the module is a steered wheel).
+  J steering_at(double t) const;
   /// The angle jet from its value and the rate jet.
   static J integrate(double value, const J& rate);
-  /// Position and attitude (sensor axes) jets of the IMU.
-  void imu_jets(double t, const JV& p_o, const JM& C_v, const J& alpha, JV& p, JM& C_s,
-                const JV* vib_disp = nullptr, const JV* vib_rot = nullptr) const;
+  /// Position and attitude (sensor axes) jets of the IMU; `delta`: the steering angle
+  /// (steering_at(t); used by steered wheels only).
+  void imu_jets(double t, const JV& p_o, const JM& C_v, const J& alpha, const J& delta, JV& p,
+                JM& C_s, const JV* vib_disp = nullptr, const JV* vib_rot = nullptr) const;
 
  private:
   struct NodeResult {
     Vec3 gyro, accel;
   };
-  NodeResult node(double t, const JV& p_o, const JM& C_v, const J& alpha, const JV* disp,
-                  const JV* rot) const;
+  NodeResult node(double t, const JV& p_o, const JM& C_v, const J& alpha, const J& delta,
+                  const JV* disp, const JV* rot) const;
 
   const Scenario& scenario_;
   StepperClock clock_;
   const ModuleModel& m_;
   double offset_;
-  bool wheel_;
+  bool wheel_, steered_;
   Vibration vib_;  // a copy with the node phasors of this stepper
   double h_;
   double node_offset_[4];

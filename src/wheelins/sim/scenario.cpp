@@ -29,6 +29,14 @@ J compose(const double* f, const J& u) {
   return r;
 }
 
+/// The signed curvature of a horizontal curve (north, east) from its first and second
+/// derivatives with respect to any parameter: positive turning right (clockwise seen from above).
+J horizontal_curvature(const J& xn, const J& xe, const J& xnn, const J& xee) {
+  const J m2 = xn * xn + xe * xe;
+  const J m = sqrt(m2);
+  return (xn * xee - xe * xnn) / (m2 * m);
+}
+
 // 4-point Gauss-Legendre on [-1, 1].
 constexpr double kGlX[4] = {-0.86113631159405257522, -0.33998104358485626480,
                             0.33998104358485626480, 0.86113631159405257522};
@@ -36,6 +44,105 @@ constexpr double kGlW[4] = {0.34785484513745385737, 0.65214515486254614263,
                             0.65214515486254614263, 0.34785484513745385737};
 
 std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+/// The smoothed path of a polyline as PathScenario drives it: knots at the cumulative chord
+/// lengths (vertices closer than 1e-6 m to the last kept one dropped), extended beyond its ends
+/// along its first and last chords. Empty knots if the polyline has no length.
+GaussPolyline<2> smoothed_path(const std::vector<std::array<double, 2>>& pts, double sigma) {
+  std::vector<double> u{0.0};
+  std::vector<std::array<double, 2>> p{pts[0]};
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const double d = std::hypot(pts[i][0] - p.back()[0], pts[i][1] - p.back()[1]);
+    if (d < 1e-6) continue;
+    u.push_back(u.back() + d);
+    p.push_back(pts[i]);
+  }
+  if (u.size() < 2) return {};
+  const std::size_t n = u.size();
+  std::array<double, 2> t0{(p[1][0] - p[0][0]) / (u[1] - u[0]), (p[1][1] - p[0][1]) / (u[1] - u[0])};
+  std::array<double, 2> t1{(p[n - 1][0] - p[n - 2][0]) / (u[n - 1] - u[n - 2]),
+                           (p[n - 1][1] - p[n - 2][1]) / (u[n - 1] - u[n - 2])};
+  return GaussPolyline<2>(u, p, sigma, t0, t1);
+}
+
+/// The curvature of a smoothed path at u (positive turning right).
+double smoothed_curvature(const GaussPolyline<2>& path, double u) {
+  std::array<double, 2> d[3];
+  path.eval(u, 2, d);
+  const double m = std::hypot(d[1][0], d[1][1]);
+  return (d[1][0] * d[2][1] - d[1][1] * d[2][0]) / (m * m * m);
+}
+
+/// The arc before the T of a start with the wheels turned (DefaultScenarioOptions::
+/// start_curvature): vertices on a circle that ends at pts[0] heading along pts[0] -> pts[1].
+/// The vehicle starts `lead` (chord length) before pts[0]; the circle goes on backwards for 12
+/// path sigmas, so the smoothing sees an arc behind the start (the polyline's straight
+/// extension would halve the curvature there). The Gaussian smoothing of a circle of radius R
+/// along its length is a circle of radius R exp(-sigma^2 / 2R^2), and the T ahead pulls the
+/// curvature down: the circle's curvature is solved (secant method) so that the smoothed path's
+/// curvature at the start is the target.
+struct StartArc {
+  std::vector<std::array<double, 2>> vertices;  ///< before pts[0] (pts[0] not included)
+  std::size_t start = 0;                        ///< the vertex where o starts
+  double lead = 0.0;                            ///< chord length from the start to pts[0] [m]
+  double curvature = 0.0;                       ///< of the circle [1/m]
+};
+
+StartArc start_arc(const std::vector<std::array<double, 2>>& pts, double kappa, double sigma) {
+  const double dn = pts[1][0] - pts[0][0], de = pts[1][1] - pts[0][1];
+  const double psi1 = std::atan2(de, dn);
+  const double back = 12.0 * sigma;
+  // The arc (polyline length): a quarter turn, at most max(20 m, 3 sigma), but at least 5 m of
+  // driving + 2 sigma (the smoothing straightens the path over ~2 sigma before the T). The
+  // smoothed circle is smaller by about k / kappa, and so is the distance driven along it.
+  // Vertices at most sigma / 2 and 30 degrees apart: the smoothing leaves of the chords' ripple
+  // (period h) exp(-2 pi^2 sigma^2 / h^2) = 5e-35; their mean radius is solved below.
+  auto arc_length = [&](double k) {
+    return std::max(5.0 * std::abs(kappa / k) + 2.0 * sigma,
+                    std::min(0.5 * kPi / std::abs(k), std::max(20.0, 3.0 * sigma)));
+  };
+  const double h0 = std::min(0.5 * sigma, 30.0 * kDeg / std::abs(kappa));
+  const int n_arc = std::max(4, static_cast<int>(std::ceil(arc_length(kappa) / h0)));
+  const int n_back = static_cast<int>(std::ceil(back / h0));
+  auto build = [&](double k) {
+    StartArc a;
+    a.curvature = k;
+    const double la = arc_length(k), h = la / n_arc;
+    // Arc length s <= 0 from pts[0]: heading psi1 + k s.
+    for (int i = -(n_arc + n_back); i < 0; ++i) {
+      const double s = i * h, psi = psi1 + k * s;
+      a.vertices.push_back({pts[0][0] + (std::sin(psi) - std::sin(psi1)) / k,
+                            pts[0][1] + (std::cos(psi1) - std::cos(psi)) / k});
+    }
+    a.start = static_cast<std::size_t>(n_back);
+    a.lead = n_arc * 2.0 * std::sin(0.5 * std::abs(k) * h) / std::abs(k);
+    return a;
+  };
+  // The curvature of the smoothed path (the arc and the first sides of the T) at the start.
+  auto smoothed = [&](const StartArc& a) {
+    std::vector<std::array<double, 2>> all = a.vertices;
+    for (std::size_t i = 0; i < pts.size() && i < 16; ++i) all.push_back(pts[i]);
+    const GaussPolyline<2> path = smoothed_path(all, sigma);
+    return smoothed_curvature(path, path.knots()[a.start]);
+  };
+  // Secant on log |k|: the smoothed curvature grows with the circle's (it is not a contraction,
+  // so a fixed-point iteration would not do).
+  const double sign = kappa > 0.0 ? 1.0 : -1.0;
+  auto residual = [&](double x) { return std::log(sign * smoothed(build(sign * std::exp(x)))) - std::log(std::abs(kappa)); };
+  double x0 = std::log(std::abs(kappa)), x1 = x0 - 0.1 * (1.0 + sigma * std::abs(kappa));
+  double g0 = residual(x0), g1 = residual(x1);
+  for (int it = 0; it < 100 && std::abs(g1) > 1e-13; ++it) {
+    if (g1 == g0) break;
+    const double x2 = x1 - g1 * (x1 - x0) / (g1 - g0);
+    x0 = x1, g0 = g1;
+    x1 = x2;
+    g1 = residual(x1);
+  }
+  if (!(std::abs(g1) < 1e-9))
+    throw InputError("start steering: no arc of curvature " + std::to_string(kappa) +
+                     " 1/m after smoothing with sigma " + std::to_string(sigma) + " m");
+  return build(sign * std::exp(x1));
+}
 
 }  // namespace
 
@@ -95,20 +202,8 @@ Terrain Terrain::gentle(double max_slope_deg, std::uint64_t seed) {
 PathScenario::PathScenario(PathScenarioSpec spec) : spec_(std::move(spec)) {
   const auto& pts = spec_.path_ne;
   if (pts.size() < 2) throw InputError("scenario '" + spec_.name + "': the path needs at least two points");
-  std::vector<double> u{0.0};
-  std::vector<std::array<double, 2>> p{pts[0]};
-  for (std::size_t i = 1; i < pts.size(); ++i) {
-    const double d = std::hypot(pts[i][0] - p.back()[0], pts[i][1] - p.back()[1]);
-    if (d < 1e-6) continue;
-    u.push_back(u.back() + d);
-    p.push_back(pts[i]);
-  }
-  if (u.size() < 2) throw InputError("scenario '" + spec_.name + "': the path has no length");
-  const std::size_t n = u.size();
-  std::array<double, 2> t0{(p[1][0] - p[0][0]) / (u[1] - u[0]), (p[1][1] - p[0][1]) / (u[1] - u[0])};
-  std::array<double, 2> t1{(p[n - 1][0] - p[n - 2][0]) / (u[n - 1] - u[n - 2]),
-                           (p[n - 1][1] - p[n - 2][1]) / (u[n - 1] - u[n - 2])};
-  path_ = GaussPolyline<2>(u, p, spec_.path_sigma, t0, t1);
+  path_ = smoothed_path(pts, spec_.path_sigma);
+  if (path_.knots().size() < 2) throw InputError("scenario '" + spec_.name + "': the path has no length");
 
   std::vector<std::array<double, 1>> pu;
   for (double x : spec_.profile_u) pu.push_back({x});
@@ -153,9 +248,8 @@ void PathScenario::evaluate(double t, JV& p_inN, JM& C_VtoN) const {
   J heading = atan2(xe, xn);
   if (spec_.skid_coeff != 0.0) {
     const J xnn = comp(2, 0), xee = comp(2, 1);  // d2p/du2
-    const J m2 = xn * xn + xe * xe;
-    const J m = sqrt(m2);
-    const J kappa = (xn * xee - xe * xnn) / (m2 * m);
+    const J m = sqrt(xn * xn + xe * xe);
+    const J kappa = horizontal_curvature(xn, xe, xnn, xee);
     const J speed = m * udot;
     // v_y = -skid * speed^2 * kappa  <=>  heading = course + atan(skid * speed * kappa)
     heading += atan(spec_.skid_coeff * speed * kappa);
@@ -187,6 +281,21 @@ void PathScenario::evaluate(double t, JV& p_inN, JM& C_VtoN) const {
   C_VtoN = JM::from_columns(x, y, z);
 }
 
+J PathScenario::path_curvature(double t) const {
+  // kappa(u(t)): the curvature's u-derivatives from the path's, composed with u(t).
+  const J u = arc(t);
+  std::array<double, 2> pd[kOrder + 3];
+  path_.eval(u.value(), kOrder + 2, pd);
+  double f[kOrder + 1];
+  auto comp = [&](int first, int dim) {
+    for (int k = 0; k <= kOrder; ++k) f[k] = pd[first + k][dim];
+    return compose(f, u);
+  };
+  return horizontal_curvature(comp(1, 0), comp(1, 1), comp(2, 0), comp(2, 1));
+}
+
+double PathScenario::curvature_at(double u) const { return smoothed_curvature(path_, u); }
+
 std::string PathScenario::describe() const {
   std::ostringstream os;
   os << spec_.name << ": polyline " << path_.knots().size() << " vertices, "
@@ -217,21 +326,36 @@ PathScenarioSpec default_scenario_spec(const DefaultScenarioOptions& opt) {
   for (int l = 0; l < opt.laps; ++l)
     for (std::size_t i = (l == 0 ? 0 : 1); i < lap.size(); ++i) pts.push_back(rot(lap[i]));
   pts.push_back(rot(lap[0]));  // back to the start point
-  // Shift so the start point is the origin.
-  const auto p0 = pts[0];
-  for (auto& q : pts) q = {q[0] - p0[0], q[1] - p0[1]};
-  s.path_ne = pts;
   double L = 0.0;
   for (std::size_t i = 1; i < pts.size(); ++i) L += std::hypot(pts[i][0] - pts[i - 1][0], pts[i][1] - pts[i - 1][1]);
   const double lap_len = L / opt.laps;
+  // A start with the wheels turned: the arc before the T; o starts on it at arc length u0 of
+  // the polyline and reaches the T's start point after `lead` metres.
+  double u0 = 0.0, lead = 0.0;
+  if (opt.start_curvature != 0.0) {
+    const StartArc arc = start_arc(pts, opt.start_curvature, opt.path_sigma);
+    pts.insert(pts.begin(), arc.vertices.begin(), arc.vertices.end());
+    const GaussPolyline<2> path = smoothed_path(pts, opt.path_sigma);
+    u0 = path.knots()[arc.start];
+    lead = path.knots()[arc.vertices.size()] - u0;
+    // Shift so that o starts at the origin (the smoothed path's point, not the vertex).
+    std::array<double, 2> p0[1];
+    path.eval(u0, 0, p0);
+    for (auto& q : pts) q = {q[0] - p0[0][0], q[1] - p0[0][1]};
+  } else {
+    // Shift so the start point is the origin.
+    const auto p0 = pts[0];
+    for (auto& q : pts) q = {q[0] - p0[0], q[1] - p0[1]};
+  }
+  s.path_ne = pts;
 
   // Speed profile: piecewise-constant speed (integrated: piecewise-linear u), smoothed.
   // Motion starts 6 sigma after the static period so that it is static to ~1e-8 m/s^2.
   double t = opt.start_time + opt.static_duration + 6.0 * opt.profile_sigma;
   s.static_end = opt.start_time + opt.static_duration;
   s.profile_t = {opt.start_time, t};
-  s.profile_u = {0.0, 0.0};
-  double u = 0.0;
+  s.profile_u = {u0, u0};
+  double u = u0;
   auto drive_to = [&](double target) {
     t += (target - u) / opt.speed;
     u = target;
@@ -244,7 +368,7 @@ PathScenarioSpec default_scenario_spec(const DefaultScenarioOptions& opt) {
     s.profile_u.push_back(u);
   };
   for (int l = 1; l <= opt.laps; ++l) {
-    drive_to(l * lap_len);
+    drive_to(u0 + lead + l * lap_len);
     if (opt.stops && l < opt.laps && l % 2 == 0) dwell(15.0);  // ~8 s fully stopped
   }
   s.end_time = t + 6.0 * opt.profile_sigma + 20.0;

@@ -50,6 +50,11 @@ class Scenario {
   virtual earth::Geodetic origin() const = 0;
   /// Position of o (n-frame) and C_v^n as jets at time t.
   virtual void evaluate(double t, JV& p_inN, JM& C_VtoN) const = 0;
+  /// The signed horizontal curvature of the path of o at time t as a jet in t [1/m]
+  /// (positive: turning right, the n-frame being NED). It is a function of the position
+  /// along the path, so it is defined at rest too (a steered wheel keeps its angle when the
+  /// vehicle stops). Zero unless the scenario has a path.
+  virtual J path_curvature(double t) const { (void)t; return J(0.0); }
   virtual std::string describe() const = 0;
 
   VehicleState state(double t) const;
@@ -96,8 +101,11 @@ class PathScenario : public Scenario {
   double static_end() const override { return spec_.static_end; }
   earth::Geodetic origin() const override { return spec_.origin; }
   void evaluate(double t, JV& p_inN, JM& C_VtoN) const override;
+  J path_curvature(double t) const override;
   std::string describe() const override;
   const PathScenarioSpec& spec() const { return spec_; }
+  /// The curvature of the smoothed path at arc length u (the derivatives of p~(u)) [1/m].
+  double curvature_at(double u) const;
   /// Arc length parameter u(t) and its derivatives as a jet.
   J arc(double t) const;
   double polyline_length() const;
@@ -122,6 +130,11 @@ struct DefaultScenarioOptions {
   double scale = 1.0;          ///< size of the T (1: 254 m per lap)
   double skid_coeff = 0.0;
   Terrain terrain;
+  /// A start with the wheels turned [1/m] (0: none): o starts at rest on an arc whose
+  /// smoothed path has exactly this curvature at the start (positive: turning right), drives
+  /// along it (a quarter turn, at most max(20 m, 3 path sigmas), at least 5 m of driving + 2 sigmas) and
+  /// joins the T where the lap starts, along its first side.
+  double start_curvature = 0.0;
 };
 PathScenarioSpec default_scenario_spec(const DefaultScenarioOptions& opt);
 

@@ -27,17 +27,29 @@ double cruise_speed_of(const Scenario& s) {
 }  // namespace
 
 const char* Simulation::group_name(int g) {
-  static const char* n[] = {"left-wheel", "right-wheel", "body"};
+  static const char* n[kMaxGroups] = {"left-wheel", "right-wheel", "body", "front-left-wheel",
+                                      "front-right-wheel"};
   return n[g];
 }
 const char* Simulation::group_dir(int g) {
-  static const char* n[] = {"left-wheel-imu", "right-wheel-imu", "body-imu"};
+  static const char* n[kMaxGroups] = {"left-wheel-imu", "right-wheel-imu", "body-imu",
+                                      "front-left-wheel-imu", "front-right-wheel-imu"};
   return n[g];
+}
+const char* Simulation::chip_prefix(int g) {
+  static const char* n[kMaxGroups] = {"left", "right", "body", "front-left", "front-right"};
+  return n[g];
+}
+
+int Simulation::group_index(const std::string& name) const {
+  for (int g = 0; g < groups(); ++g)
+    if (name == group_name(g)) return g;
+  return -1;
 }
 
 Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
   cfg_.validate();
-  const bool car = cfg_.vehicle.preset == "car";
+  const bool car = cfg_.vehicle.car();
   Terrain terrain;
   if (cfg_.terrain_slope_deg > 0.0) terrain = Terrain::gentle(cfg_.terrain_slope_deg, cfg_.seed);
   const double skid = cfg_.on("skid") ? cfg_.errors.skid_coeff : 0.0;
@@ -54,6 +66,9 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     o.stops = cfg_.stops;
     o.skid_coeff = skid;
     o.terrain = terrain;
+    // The front axle's centre (wheelbase, 0) turned by D: kappa = tan(D) / wheelbase.
+    if (cfg_.start_steering_deg != 0.0)
+      o.start_curvature = std::tan(cfg_.start_steering_deg * kDeg) / cfg_.vehicle.wheelbase;
     scenario_ = std::make_unique<PathScenario>(default_scenario_spec(o));
   } else {
     PathFileOptions o;
@@ -77,12 +92,19 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
   omega_ie_ = cfg_.earth_rotation ? earth::earth_rate_ned(org.lat) : Vec3::Zero();
 
   // Modules: true geometry, manifest geometry, per-module physical draws; then the chips.
-  const ModuleGeometry* geo[kGroups] = {&cfg_.vehicle.left, &cfg_.vehicle.right, &cfg_.vehicle.body};
-  for (int g = 0; g < kGroups; ++g) {
+  // Every draw has its own stream named by the module or chip: the front wheels' draws leave
+  // those of the other modules unchanged.
+  const std::vector<const ModuleGeometry*> geo = cfg_.vehicle.modules();
+  if (geo.size() > static_cast<std::size_t>(kMaxGroups)) throw InputError("simulate: too many modules");
+  modules_.resize(geo.size());
+  chips_.resize(geo.size());
+  for (int g = 0; g < groups(); ++g) {
+    if (geo[g]->group != group_name(g))
+      throw InputError(std::string("simulate: module ") + std::to_string(g) + " is '" + geo[g]->group +
+                       "', expected '" + group_name(g) + "'");
     modules_[g] = draw_module(cfg_, group_name(g), *geo[g], cruise);
     for (int c = 1; c <= cfg_.chips; ++c)
-      chips_[g].push_back(draw_chip(cfg_, (g == 0 ? "left" : g == 1 ? "right" : "body") +
-                                              std::string("-C") + std::to_string(c)));
+      chips_[g].push_back(draw_chip(cfg_, chip_prefix(g) + std::string("-C") + std::to_string(c)));
   }
 
   // Fault events: the targets must exist and the start must lie within the data. They use no
@@ -97,6 +119,11 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
                          " chip" + (cfg_.chips == 1 ? "" : "s") + " per module: C1..C" +
                          std::to_string(cfg_.chips) + ")");
     }
+    bool exists = false;  // the front wheels' targets need the preset that has them
+    for (int g = 0; g < groups(); ++g)
+      for (const ChipModel& c : chips_[g]) exists = exists || f.targets(group_name(g), c.name);
+    if (!exists)
+      throw InputError(what + "the vehicle (preset " + cfg_.vehicle.preset + ") has no module " + f.target);
     if (!(f.start < span))
       throw InputError(what + "the start " + num(f.start) + " s is outside the data (0 to " + num(span) +
                        " s since the start of the data)");
@@ -105,7 +132,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
       e.t0 = start_time() + f.start;
       e.t1 = f.end ? start_time() + *f.end : std::numeric_limits<double>::infinity();
       e.ratio = f.ratio;
-      modules_[f.target == "left-wheel" ? 0 : 1].slip_events.push_back(e);
+      modules_[group_index(f.target)].slip_events.push_back(e);
     }
   }
 }

@@ -1,5 +1,6 @@
 // The multi-IMU simulator's facade: exact IMU data for two Wheel-IMUs and a
-// Body-IMU (four chips each) from a Scenario, with a seeded, switchable error
+// Body-IMU (four chips each; preset car-steered: two more Wheel-IMUs on the steered
+// front wheels) from a Scenario, with a seeded, switchable error
 // model, and the dataset writer behind `wheelins simulate`.
 //
 // Physics (docs/simulator.md): every IMU point's position and attitude are
@@ -45,7 +46,11 @@ struct DatasetSummary {
 
 class Simulation {
  public:
-  static constexpr int kGroups = 3;  ///< left-wheel, right-wheel, body
+  /// left-wheel, right-wheel, body: the groups of every preset (groups 0..2).
+  static constexpr int kGroups = 3;
+  /// With the steered front wheels of preset car-steered: front-left-wheel (3) and
+  /// front-right-wheel (4).
+  static constexpr int kMaxGroups = 5;
 
   /// Builds the scenario and draws every random parameter from cfg.seed.
   /// `base_dir` resolves relative scenario/speed paths.
@@ -62,6 +67,8 @@ class Simulation {
   std::uint64_t sample_count() const;
   double stamp(std::uint64_t k) const { return start_time() + static_cast<double>(k) / cfg_.rate_hz; }
   double speed_scale() const { return speed_scale_; }
+  /// The number of module groups of this vehicle: kGroups, or kMaxGroups with steered wheels.
+  int groups() const { return static_cast<int>(modules_.size()); }
   const ModuleModel& module(int g) const { return modules_[g]; }
   const std::vector<ChipModel>& chips(int g) const { return chips_[g]; }
   double gravity() const { return gravity_; }
@@ -92,8 +99,11 @@ class Simulation {
   /// unless `force`. Shows progress on a terminal when `progress`.
   DatasetSummary write(const std::filesystem::path& dir, bool force, bool progress) const;
 
-  static const char* group_name(int g);
-  static const char* group_dir(int g);
+  static const char* group_name(int g);   ///< "left-wheel", ..., "front-right-wheel"
+  static const char* group_dir(int g);    ///< "left-wheel-imu", ...
+  static const char* chip_prefix(int g);  ///< "left" (chips left-C1.., stream left-ideal), ...
+  /// The group of that name in this simulation, or -1.
+  int group_index(const std::string& name) const;
 
   /// The sample grid and the environment of the group steppers.
   StepperClock clock() const;
@@ -109,8 +119,8 @@ class Simulation {
   double speed_scale_ = 1.0;
   double gravity_ = 9.8;
   Vec3 omega_ie_ = Vec3::Zero();
-  std::array<ModuleModel, kGroups> modules_;
-  std::array<std::vector<ChipModel>, kGroups> chips_;
+  std::vector<ModuleModel> modules_;             ///< per group; never resized after construction
+  std::vector<std::vector<ChipModel>> chips_;
 };
 
 }  // namespace wheelins::sim

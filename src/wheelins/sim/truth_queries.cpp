@@ -19,6 +19,7 @@ double Simulation::slip_extra_angle(int g, const ModuleModel::SlipEvent& e) cons
   // alpha_dot - (fault-free alpha_dot) = ratio * w(t) * v_wc(t) / R (see wheel_rate_jet);
   // 4-point Gauss-Legendre over steps of one sample interval from t0 (w is C-infinity).
   const ModuleModel& m = modules_[g];
+  const GroupStepper st = stepper(g, 0.0);
   const double h = 1.0 / cfg_.rate_hz, b_end = std::min(e.t1, end_);
   double sum = 0.0;
   for (double a = e.t0; a < b_end; a += h) {
@@ -29,7 +30,7 @@ double Simulation::slip_extra_angle(int g, const ModuleModel::SlipEvent& e) cons
       JM C_v;
       scenario_->evaluate(t, p_o, C_v);
       sum += 0.5 * (b - a) * kGlW[i] * e.ratio * slip_window<kOrder>(t, e.t0, e.t1).value() *
-             wheel_centre_speed_of(m, p_o, C_v) / m.radius;
+             wheel_centre_speed_of(m, p_o, C_v, st.steering_at(t)) / m.radius;
     }
   }
   return sum;
@@ -55,14 +56,17 @@ ImuTruth Simulation::truth(int g, double t) const {
   scenario_->evaluate(t, p_o, C_v);
   ImuTruth r;
   J alpha_jet(0.0);
+  const J delta = st.steering_at(t);
   if (m.truth.wheel) {
-    const J rate = wheel_rate_jet(m, t, p_o, C_v);
+    const J rate = wheel_rate_jet(m, t, p_o, C_v, delta);
     alpha_jet = GroupStepper::integrate(alpha, rate);
     r.wheel_angle = alpha;
     r.wheel_rate = rate.value();
-    r.wheel_centre_speed = wheel_centre_speed_of(m, p_o, C_v);
+    r.wheel_centre_speed = wheel_centre_speed_of(m, p_o, C_v, delta);
+    r.steering_angle = delta.value();
+    r.steering_rate = delta.deriv(1);
   }
-  st.imu_jets(t, p_o, C_v, alpha_jet, p, C_s);
+  st.imu_jets(t, p_o, C_v, alpha_jet, delta, p, C_s);
   r.p_inN = p.deriv(0);
   r.v_inN = p.deriv(1);
   r.a_inN = p.deriv(2);
