@@ -18,5 +18,5 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # (ideal data add no error, covariances stay positive definite, centralized equals distributed,
 # finite-difference Jacobians over a run, noise identification over a run) whose code paths the
 # tests kept here walk already, at 50-90 s each under the sanitizers (CI must stay under 45 min).
-numeric_only='^(NavEndToEnd\.(CovariancesStaySymmetricPositiveDefinite|IdealCentralizedWithMeanWheelSpeedKeepsHeading|CentralizedEqualsDistributedWithoutConstraint|IdealSingleWheelInsAddsNoError|IdealMultiImuWithOwnWheelSpeedAddsNoError|CentralizedMeasurementJacobiansMatchFiniteDifference)|NoiseAdaptationEndToEnd\.(NoRunawayWithoutNoiseFigures|YawRateScaleFactorsByConfiguration)|FusionFaults\.NoFalseAlarmsOnAFaultFreeRun)$'
+numeric_only='^(NavEndToEnd\.(CovariancesStaySymmetricPositiveDefinite|IdealCentralizedWithMeanWheelSpeedKeepsHeading|CentralizedEqualsDistributedWithoutConstraint|IdealSingleWheelInsAddsNoError|IdealMultiImuWithOwnWheelSpeedAddsNoError|CentralizedMeasurementJacobiansMatchFiniteDifference)|NoiseAdaptationEndToEnd\.(NoRunawayWithoutNoiseFigures|YawRateScaleFactorsByConfiguration)|FusionFaults\.NoFalseAlarmsOnAFaultFreeRun|SteeredWheels\..*|SimPhysics\.JetDerivativesMatchCentralDifferencesOnSteeredWheels)$'
 ctest --test-dir "$build" -j"$(nproc)" --output-on-failure -E "$numeric_only"

@@ -110,8 +110,12 @@ void WheelIns::propagate(const ImuSample& body_sample) {
   window_sum_ += wx;
   window_pos_ = (window_pos_ + 1) % window_len_;
   if (module_.steered) {
+    // This sample's speed (the window's mean lags by half the window: 4 % of the distance
+    // rolled while a car starts to roll, which the start's steering would take for a turn).
+    const ImuErrors& e = ekf_.errors();
+    const double speed = -axle_sign_ * module_.wheel_radius * (wx - e.bg.x()) / (1.0 + e.sg.x());
     const SteeringObserver::Step st =
-        steer_.step(yaw_rate(), wheel_speed(), body_sample.dt,
+        steer_.step(yaw_rate(), speed, body_sample.dt,
                     wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_), reference_heading_);
     if (st.rolling_began) roll_pivot_ = ekf_.state().p_IinW;
     if (st.turn != 0.0) ekf_.rotate_about_vertical(st.turn, roll_pivot_);
