@@ -112,8 +112,7 @@ void WheelIns::propagate(const ImuSample& body_sample) {
   if (module_.steered) {
     // This sample's speed (the window's mean lags by half the window: 4 % of the distance
     // rolled while a car starts to roll, which the start's steering would take for a turn).
-    const ImuErrors& e = ekf_.errors();
-    const double speed = -axle_sign_ * module_.wheel_radius * (wx - e.bg.x()) / (1.0 + e.sg.x());
+    const double speed = -axle_sign_ * module_.wheel_radius * compensated_omega_x(wx);
     const SteeringObserver::Step st =
         steer_.step(yaw_rate(), speed, body_sample.dt,
                     wheel_vehicle_heading(ekf_.state().C_ItoW(), axle_sign_), reference_heading_);
@@ -145,10 +144,13 @@ bool WheelIns::turn_averaged(const WheelVelocityInput& now, TurnAverage& out,
   return true;
 }
 
-double WheelIns::mean_omega_x() const {
-  if (!window_count_) return 0.0;
+double WheelIns::compensated_omega_x(double raw) const {
   const ImuErrors& e = ekf_.errors();
-  return (window_sum_ / window_count_ - e.bg.x()) / (1.0 + e.sg.x());
+  return (raw - e.bg.x()) / (1.0 + e.sg.x());
+}
+
+double WheelIns::mean_omega_x() const {
+  return window_count_ ? compensated_omega_x(window_sum_ / window_count_) : 0.0;
 }
 
 WheelIns::SpeedSensitivity WheelIns::speed_sensitivity() const {

@@ -126,6 +126,8 @@ class WheelIns final : public Subsystem {
 
  private:
   void begin(const NavState& s, const ImuErrors& e, const InitialUncertainty& init);
+  /// A raw axle rate less the estimated bias and scale factor [rad/s].
+  double compensated_omega_x(double raw) const;
   WheelInsOptions opt_;
   Mat3 C_StoB_;
   int axle_sign_;
