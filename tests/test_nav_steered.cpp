@@ -3,7 +3,6 @@
 // also when the car starts with its wheels turned 20 deg, and the five-IMU configuration
 // navigates without isolating the steered wheels.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -11,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "io_test_util.hpp"
 #include "wheelins/eval/run_evaluation.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/run/run.hpp"
@@ -21,20 +21,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// The datasets of this file, removed when the test program ends.
 const fs::path& scratch_root() {
-  struct Root {
-    fs::path dir = fs::temp_directory_path() / ("wheelins-steered-" + std::to_string(::getpid()));
-    Root() {
-      fs::remove_all(dir);
-      fs::create_directories(dir);
-    }
-    ~Root() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  };
-  static const Root root;
-  return root.dir;
+  static const iotest::ScratchDir dir;
+  return dir.path();
 }
 
 /// The field profile on the car with steered front wheels, one chip per module, 300 s (about

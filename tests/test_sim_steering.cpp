@@ -8,9 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
+#include "io_test_util.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/sim/simulator.hpp"
 
@@ -75,19 +74,6 @@ double sharpest_turn(const Simulation& sim, double sign, double t0, double t1) {
     if (k > best) best = k, at = t;
   }
   return at;
-}
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("wheelins_test_steer_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  return p;
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 std::string error_of(const SimConfig& cfg) {
@@ -337,7 +323,8 @@ TEST(SimSteering, DatasetAndManifests) {
   cfg.static_duration = 2.0;
   cfg.start_steering_deg = 15.0;
   cfg.faults.push_back(parse_fault_spec("dropout:front-left-C2:4:5"));
-  const fs::path dir = temp_dir("ds");
+  const iotest::ScratchDir scratch;
+  const fs::path dir = scratch / "ds";
   Simulation(cfg).write(dir, false, false);
   const Manifest m = load_manifest(dir / "manifest.yaml");
   ASSERT_EQ(m.modules.size(), 20u);
@@ -364,19 +351,17 @@ TEST(SimSteering, DatasetAndManifests) {
   // The dropout removed one second of front-left-C2 only.
   EXPECT_EQ(fs::file_size(dir / "front-left-wheel-imu" / "tri_C2_imu.bin") + 200 * 7 * 8,
             fs::file_size(dir / "front-left-wheel-imu" / "tri_C1_imu.bin"));
-  const std::string yaml = read_file(dir / "scenario.yaml");
+  const std::string yaml = iotest::read_text_file(dir / "scenario.yaml");
   EXPECT_NE(yaml.find("start_steering_deg: 15\n"), std::string::npos);
   EXPECT_NE(yaml.find("  wheelbase_m: 2.6\n"), std::string::npos);
   SimConfig again;
   again.apply_yaml(YAML::Load(yaml), "scenario.yaml");
   EXPECT_EQ(again.to_yaml(), yaml);
-  const fs::path dir2 = temp_dir("ds2");
+  const fs::path dir2 = scratch / "ds2";
   Simulation(again).write(dir2, false, false);
   for (const char* f : {"front-left-wheel-imu/tri_C1_imu.bin", "front-right-wheel-imu/tri_C4_imu.bin",
                         "GINS.bin", "manifest.yaml", "errors.yaml"})
-    EXPECT_TRUE(read_file(dir / f) == read_file(dir2 / f)) << f;
-  fs::remove_all(dir);
-  fs::remove_all(dir2);
+    EXPECT_TRUE(iotest::read_text_file(dir / f) == iotest::read_text_file(dir2 / f)) << f;
 }
 
 // The settings: the wheelbase moves the front wheels and is checked; the start steering needs

@@ -29,6 +29,14 @@ J compose(const double* f, const J& u) {
   return r;
 }
 
+/// Component `dim` of the path's `first`-th derivative with respect to u, as a jet in t: the
+/// path's u-derivatives `pd` at u(t) composed with the jet u(t).
+J path_derivative(const std::array<double, 2>* pd, int first, int dim, const J& u) {
+  double f[kOrder + 1];
+  for (int k = 0; k <= kOrder; ++k) f[k] = pd[first + k][dim];
+  return compose(f, u);
+}
+
 /// The signed curvature of a horizontal curve (north, east) from its first and second
 /// derivatives with respect to any parameter: positive turning right (clockwise seen from above).
 J horizontal_curvature(const J& xn, const J& xe, const J& xnn, const J& xee) {
@@ -238,11 +246,7 @@ void PathScenario::evaluate(double t, JV& p_inN, JM& C_VtoN) const {
   // Path derivatives with respect to u, up to what the jets need.
   std::array<double, 2> pd[kOrder + 3];
   path_.eval(u.value(), kOrder + 2, pd);
-  double f[kOrder + 1];
-  auto comp = [&](int first, int dim) {
-    for (int k = 0; k <= kOrder; ++k) f[k] = pd[first + k][dim];
-    return compose(f, u);
-  };
+  auto comp = [&](int first, int dim) { return path_derivative(pd, first, dim, u); };
   const J pn = comp(0, 0), pe = comp(0, 1);
   const J xn = comp(1, 0), xe = comp(1, 1);  // dp/du
   J heading = atan2(xe, xn);
@@ -286,11 +290,7 @@ J PathScenario::path_curvature(double t) const {
   const J u = arc(t);
   std::array<double, 2> pd[kOrder + 3];
   path_.eval(u.value(), kOrder + 2, pd);
-  double f[kOrder + 1];
-  auto comp = [&](int first, int dim) {
-    for (int k = 0; k <= kOrder; ++k) f[k] = pd[first + k][dim];
-    return compose(f, u);
-  };
+  auto comp = [&](int first, int dim) { return path_derivative(pd, first, dim, u); };
   return horizontal_curvature(comp(1, 0), comp(1, 1), comp(2, 0), comp(2, 1));
 }
 
