@@ -360,6 +360,24 @@ TEST(IoManifest, DuplicateModuleNamesAndKeys) {
              "modules[0].rate_hz: duplicate key");
 }
 
+TEST(IoManifest, SteeredWheelRoundTripsAndIsChecked) {
+  ScratchDir dir;
+  const auto mod = [&](const std::string& extra) {
+    return with_modules("modules:\n  - {name: a, file: a.bin" + extra + "}\n");
+  };
+  write_text(dir / "m.yaml", mod(", kind: wheel, wheel_radius_m: 0.3, steered: true, position_v_m: [2.6, -0.75, 0]"));
+  const Manifest m = load_manifest(dir / "m.yaml", kQuiet);
+  EXPECT_TRUE(m.modules[0].steered);
+  save_manifest(m, dir / "m2.yaml");
+  EXPECT_TRUE(load_manifest(dir / "m2.yaml", kQuiet).modules[0].steered);
+  EXPECT_HAS(load_error(dir, mod(", kind: body, steered: true")),
+             "modules[0].steered: only a wheel module can be steered");
+  EXPECT_HAS(load_error(dir, mod(", kind: wheel, wheel_radius_m: 0.3, steered: maybe")),
+             "modules[0].steered: expected true or false");
+  EXPECT_HAS(load_error(dir, mod(", kind: wheel, wheel_radius_m: 0.3, steered: true, position_v_m: [0.1, 0, 0]")),
+             "modules[0].position_v_m: a steered wheel's x is its distance ahead of the rear axle");
+}
+
 TEST(IoManifest, PhysicallyImpossibleValues) {
   ScratchDir dir;
   const auto mod = [&](const std::string& extra) {
