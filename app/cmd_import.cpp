@@ -12,6 +12,7 @@
 #include "cli.hpp"
 #include "wheelins/util/progress.hpp"
 #include "wheelins/io/ros/import.hpp"
+#include "wheelins/run/ros_dataset.hpp"
 #include "wheelins/run/table_dataset.hpp"
 #include "wheelins/nav/types.hpp"
 
@@ -73,10 +74,11 @@ int run(const Options& o) {
   if (o.recordings.size() != 1)
     throw InputError("a ROS recording is imported one at a time (" + std::to_string(o.recordings.size()) +
                      " given); several tables need --preset or --columns");
-  if (!o.vehicle_type.empty() || !o.vehicle.empty())
-    throw InputError("--vehicle-type and --vehicle are for tables (--preset/--columns)");
   const std::string& recording = o.recordings.front();
-  ros::ImportOptions opt;
+  RosDatasetOptions ro;
+  ro.vehicle_type = o.vehicle_type;
+  if (!o.vehicle.empty()) ro.vehicle = o.vehicle;
+  ros::ImportOptions& opt = ro.import;
   for (const auto& t : o.topics) {
     const auto eq = t.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == t.size())
@@ -99,7 +101,8 @@ int run(const Options& o) {
     bar->update(done);
   };
 
-  const ros::ImportResult r = ros::import_recording(recording, o.out, opt);
+  const RosDatasetResult d = import_ros_dataset(recording, o.out, ro);
+  const ros::ImportResult& r = d.import;
   if (bar) bar->finish();
   std::cout << "imported " << recording << " (" << r.format << ")\n";
   for (const auto& t : r.imu)
@@ -111,10 +114,14 @@ int run(const Options& o) {
       std::printf("  %-28s -> %s: %llu records, %.3f .. %.3f s\n", (*t)->topic.c_str(),
                   (*t)->file.string().c_str(), static_cast<unsigned long long>((*t)->messages),
                   (*t)->t_first, (*t)->t_last);
-  std::cout << "wrote " << r.manifest_file.string() << "\n";
-  for (const auto& f : r.facts) std::cout << "  " << f << "\n";
-  std::cout << "still to fill in (marked TODO in the file):\n";
-  for (const auto& t : r.draft.todo) std::cout << "  - " << t << "\n";
+  std::cout << "what the data say (every module's notes are comments in the manifest):\n" << survey::survey_report(d.survey);
+  std::cout << "wrote " << d.manifest_file.string() << "\n";
+  for (const auto& f : d.draft.facts)
+    if (f.rfind("what the data say:", 0) != 0) std::cout << "  " << f << "\n";
+  if (!d.draft.todo.empty()) {
+    std::cout << "still to fill in (marked TODO in the file):\n";
+    for (const auto& t : d.draft.todo) std::cout << "  - " << t << "\n";
+  }
   return 0;
 }
 
@@ -133,9 +140,9 @@ const bool registered = cli::register_command(
                      "tables: the largest fraction of a table's rows that may be left out as faults")
           ->capture_default_str();
       sub.add_option("--vehicle-type", o->vehicle_type,
-                     "tables: car | robot: the typical values written where the data cannot tell (default car)");
+                     "car | robot: the typical values written where the data cannot tell (default car)");
       sub.add_option("--vehicle", o->vehicle,
-                     "tables: a calibrated manifest of the same vehicle: its radii, mountings, lever arms, "
+                     "a calibrated manifest of the same vehicle: its radii, mountings, lever arms, "
                      "positions and antenna are used for modules of the same name");
       sub.add_option("--out,-o", o->out, "Output dataset directory (empty or new)")->required();
       sub.add_option("--topic", o->topics,

@@ -9,13 +9,16 @@ build=${2:-build-fuzz}
 cd "$(dirname "$0")/.."
 CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_FUZZ=ON \
   -DWHEELINS_BUILD_TESTS=OFF -DWHEELINS_BUILD_BENCH=OFF > /dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz_imu_file fuzz_truth fuzz_truth_text fuzz_config fuzz_mcap fuzz_table
-for target in imu_file truth truth_text config mcap table; do
+cmake --build "$build" -j"$(nproc)" --target fuzz_imu_file fuzz_truth fuzz_truth_text fuzz_config fuzz_mcap fuzz_ros1 fuzz_table
+for target in imu_file truth truth_text config mcap ros1 table; do
   corpus_seed="fuzz/corpus/${target%_file}"
   work="$build/corpus-$target"
   mkdir -p "$work"
   echo "== fuzz_$target for ${seconds} s"
-  "$build/fuzz_$target" -max_total_time="$seconds" -print_final_stats=1 -max_len=4096 \
+  # A ROS 1 bag holds its message definitions twice (in the chunk and the index): 32 KiB.
+  max_len=4096
+  [ "$target" = ros1 ] && max_len=32768
+  "$build/fuzz_$target" -max_total_time="$seconds" -print_final_stats=1 -max_len=$max_len \
     -artifact_prefix="$build/crash-$target-" "$work" "$corpus_seed" 2>&1 |
     grep -E "stat::number_of_executed_units|stat::new_units_added|ERROR|SUMMARY|Done" || true
   if ls "$build"/crash-"$target"-* > /dev/null 2>&1; then

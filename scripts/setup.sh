@@ -3,12 +3,15 @@
 # Idempotent: when everything is present it only checks and returns.
 # gnuplot-nox draws the plots of `wheelins experiment` and `wheelins study report` (optional at
 # run time); parallel (GNU parallel) runs a study's jobs in scripts/study-parallel.sh.
-# ROS recordings (`wheelins import`): the ROS 1 bag library and message headers, sqlite3,
-# zstd and lz4. The Python module: pybind11 and Debian's python3 (/usr/bin/python3) with
-# numpy, pytest and matplotlib (its tests and the example in examples/).
+# ROS recordings (`wheelins import`): sqlite3, zstd, lz4 and bzip2 for our readers of ROS 1
+# bags, ROS 2 bags and MCAP. The tests write ROS 1 bags with Debian's ROS 1 bag library, an
+# implementation independent of our reader. The Python module: pybind11 and Debian's python3
+# (/usr/bin/python3) with numpy, pytest and matplotlib (its tests and the example in examples/).
 # Optional groups, named as arguments: `fuzz` (clang and its libFuzzer/sanitizer
-# runtime, for scripts/fuzz.sh).
-# Usage: scripts/setup.sh [fuzz]
+# runtime, for scripts/fuzz.sh). `no-ros` leaves out the ROS 1 packages, for a build with
+# -DWHEELINS_ROS1=OFF (a cluster node, a machine without Debian's ROS packages): the program
+# is the same (it needs no ROS either way); only the tests that write ROS 1 bags are skipped.
+# Usage: scripts/setup.sh [fuzz] [no-ros]
 set -euo pipefail
 
 packages=(
@@ -16,16 +19,19 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox parallel
-  librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev
+  libbz2-dev
   libsqlite3-dev libzstd-dev liblz4-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-yaml
 )
+ros1=(librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev)
 for group in "$@"; do
   case $group in
     fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    *) echo "setup: unknown package group '$group' (known: fuzz)" >&2; exit 2 ;;
+    no-ros) ros1=() ;;
+    *) echo "setup: unknown package group '$group' (known: fuzz, no-ros)" >&2; exit 2 ;;
   esac
 done
+packages+=("${ros1[@]}")
 
 missing=()
 for p in "${packages[@]}"; do

@@ -22,9 +22,12 @@ struct OutMessage {
   std::vector<ros::Transform> tf;  ///< kTf
 };
 
-/// ROS 1 bag; compression "none", "lz4" or "bz2".
+/// ROS 1 bag; compression "none", "lz4" or "bz2". Written with the ROS bag library, so only in
+/// a build with WHEELINS_ROS1=ON (cmake/ros_tests.cmake); a test that needs it skips without.
+#if WHEELINS_HAVE_ROS1
 void write_ros1_bag(const std::filesystem::path& file, const std::vector<OutMessage>& msgs,
                     const std::string& compression = "none");
+#endif
 
 /// The CDR (XCDR1) payload of a message, little- or big-endian.
 std::vector<std::uint8_t> cdr_payload(const OutMessage& m, bool big_endian = false);

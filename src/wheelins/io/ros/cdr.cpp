@@ -11,7 +11,12 @@ namespace {
 constexpr std::size_t kHeader = 4;
 }
 
-CdrReader::CdrReader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {
+CdrReader::CdrReader(const std::uint8_t* data, std::size_t size, Serialization s)
+    : data_(data), size_(size), ros1_(s == Serialization::kRos1) {
+  if (ros1_) {
+    pos_ = 0;
+    return;
+  }
   if (size < kHeader)
     throw CdrError("CDR payload of " + std::to_string(size) +
                    " bytes is shorter than its 4-byte encapsulation header");
@@ -25,6 +30,7 @@ CdrReader::CdrReader(const std::uint8_t* data, std::size_t size) : data_(data), 
 }
 
 void CdrReader::align(std::size_t n) {
+  if (ros1_) return;
   const std::size_t rel = pos_ - kHeader;
   const std::size_t pad = (n - rel % n) % n;
   pos_ = pad > size_ - pos_ ? size_ : pos_ + pad;
@@ -32,7 +38,7 @@ void CdrReader::align(std::size_t n) {
 
 const std::uint8_t* CdrReader::take(std::size_t n, const char* field) {
   if (n > size_ - pos_)
-    throw CdrError("CDR payload ends at byte " + std::to_string(size_) + " while reading " + field +
+    throw CdrError(std::string(ros1_ ? "ROS 1" : "CDR") + " payload ends at byte " + std::to_string(size_) + " while reading " + field +
                    " (" + std::to_string(n) + " bytes at byte " + std::to_string(pos_) + ")");
   const std::uint8_t* p = data_ + pos_;
   pos_ += n;
@@ -72,33 +78,34 @@ std::string CdrReader::str(const char* field) {
   const std::uint32_t n = u32(field);
   if (n == 0) return {};  // some writers emit 0 for the empty string
   const std::uint8_t* p = take(n, field);
+  if (ros1_) return std::string(reinterpret_cast<const char*>(p), n);
   if (p[n - 1] != 0) throw CdrError(std::string("CDR string ") + field + " is not NUL-terminated");
   return std::string(reinterpret_cast<const char*>(p), n - 1);
 }
 
 Stamp CdrReader::time(const char* field) {
   Stamp s;
-  s.sec = i32(field);
+  s.sec = ros1_ ? std::int64_t{u32(field)} : std::int64_t{i32(field)};
   s.nsec = u32(field);
   if (s.nsec >= 1000000000u)
     throw CdrError(std::string(field) + ": nanosec " + std::to_string(s.nsec) + " is not below 1e9");
   return s;
 }
 
-namespace {
-// std_msgs/Header: builtin_interfaces/Time stamp, string frame_id.
-void header(CdrReader& r, Stamp& stamp, std::string& frame) {
-  stamp = r.time("header.stamp");
-  frame = r.str("header.frame_id");
+// std_msgs/Header: (ROS 1: uint32 seq), time stamp, string frame_id.
+void CdrReader::header(Stamp& stamp, std::string& frame) {
+  if (ros1_) u32("header.seq");
+  stamp = time("header.stamp");
+  frame = str("header.frame_id");
 }
+
+namespace {
 void vec3(CdrReader& r, std::array<double, 3>& v, const char* field) { r.f64s(v.data(), 3, field); }
 void quat(CdrReader& r, std::array<double, 4>& q, const char* field) { r.f64s(q.data(), 4, field); }
-}  // namespace
 
-ImuMessage decode_imu(const std::uint8_t* data, std::size_t size) {
-  CdrReader r(data, size);
+ImuMessage imu(CdrReader& r) {
   ImuMessage m;
-  header(r, m.stamp, m.frame_id);
+  r.header(m.stamp, m.frame_id);
   quat(r, m.orientation, "orientation");
   r.skip_f64(9, "orientation_covariance");
   vec3(r, m.gyro, "angular_velocity");
@@ -108,10 +115,9 @@ ImuMessage decode_imu(const std::uint8_t* data, std::size_t size) {
   return m;
 }
 
-PoseMessage decode_odometry(const std::uint8_t* data, std::size_t size) {
-  CdrReader r(data, size);
+PoseMessage odometry(CdrReader& r) {
   PoseMessage m;
-  header(r, m.stamp, m.frame_id);
+  r.header(m.stamp, m.frame_id);
   m.child_frame_id = r.str("child_frame_id");
   vec3(r, m.position, "pose.pose.position");
   quat(r, m.orientation, "pose.pose.orientation");
@@ -123,26 +129,24 @@ PoseMessage decode_odometry(const std::uint8_t* data, std::size_t size) {
   return m;
 }
 
-PoseMessage decode_pose_stamped(const std::uint8_t* data, std::size_t size) {
-  CdrReader r(data, size);
+PoseMessage pose_stamped(CdrReader& r) {
   PoseMessage m;
-  header(r, m.stamp, m.frame_id);
+  r.header(m.stamp, m.frame_id);
   vec3(r, m.position, "pose.position");
   quat(r, m.orientation, "pose.orientation");
   return m;
 }
 
-std::vector<Transform> decode_tf(const std::uint8_t* data, std::size_t size) {
-  CdrReader r(data, size);
+std::vector<Transform> tf(CdrReader& r) {
   const std::uint32_t n = r.u32("transforms (count)");
   // Each TransformStamped takes at least 8 + 4 + 4 + 56 bytes: a count beyond what the
   // buffer can hold is malformed (and must not size an allocation).
   if (n > r.remaining() / 72)
-    throw CdrError("CDR sequence transforms: " + std::to_string(n) + " elements cannot fit in " +
+    throw CdrError("sequence transforms: " + std::to_string(n) + " elements cannot fit in " +
                    std::to_string(r.remaining()) + " bytes");
   std::vector<Transform> out(n);
   for (auto& t : out) {
-    header(r, t.stamp, t.parent);
+    r.header(t.stamp, t.parent);
     t.child = r.str("transforms[].child_frame_id");
     vec3(r, t.translation, "transforms[].transform.translation");
     quat(r, t.rotation, "transforms[].transform.rotation");
@@ -150,15 +154,44 @@ std::vector<Transform> decode_tf(const std::uint8_t* data, std::size_t size) {
   return out;
 }
 
-void decode_cdr(MessageKind kind, const std::uint8_t* data, std::size_t size, Message& out) {
+void decode(MessageKind kind, CdrReader& r, Message& out) {
   switch (kind) {
-    case MessageKind::kImu: out.imu = decode_imu(data, size); return;
-    case MessageKind::kOdometry: out.pose = decode_odometry(data, size); return;
-    case MessageKind::kPoseStamped: out.pose = decode_pose_stamped(data, size); return;
-    case MessageKind::kTf: out.tf = decode_tf(data, size); return;
+    case MessageKind::kImu: out.imu = imu(r); return;
+    case MessageKind::kOdometry: out.pose = odometry(r); return;
+    case MessageKind::kPoseStamped: out.pose = pose_stamped(r); return;
+    case MessageKind::kTf: out.tf = tf(r); return;
     case MessageKind::kOther: break;
   }
-  throw std::logic_error("decode_cdr: no decoder for this message type");
+  throw std::logic_error("decode: no decoder for this message type");
+}
+
+}  // namespace
+
+ImuMessage decode_imu(const std::uint8_t* data, std::size_t size) {
+  CdrReader r(data, size);
+  return imu(r);
+}
+PoseMessage decode_odometry(const std::uint8_t* data, std::size_t size) {
+  CdrReader r(data, size);
+  return odometry(r);
+}
+PoseMessage decode_pose_stamped(const std::uint8_t* data, std::size_t size) {
+  CdrReader r(data, size);
+  return pose_stamped(r);
+}
+std::vector<Transform> decode_tf(const std::uint8_t* data, std::size_t size) {
+  CdrReader r(data, size);
+  return tf(r);
+}
+
+void decode_cdr(MessageKind kind, const std::uint8_t* data, std::size_t size, Message& out) {
+  CdrReader r(data, size);
+  decode(kind, r, out);
+}
+
+void decode_ros1(MessageKind kind, const std::uint8_t* data, std::size_t size, Message& out) {
+  CdrReader r(data, size, Serialization::kRos1);
+  decode(kind, r, out);
 }
 
 }  // namespace wheelins::ros

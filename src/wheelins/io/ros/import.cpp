@@ -1,6 +1,6 @@
 // wheelins import (import.hpp): the topics chosen and checked, each message validated and
 // converted (IMU files, truth, odometer speed), the module positions from /tf_static, the
-// files staged and moved into place together, the manifest drafted.
+// files staged and moved into place together.
 #include "wheelins/io/ros/import.hpp"
 
 #include <cctype>
@@ -12,7 +12,6 @@
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/imu_file.hpp"
-#include "wheelins/io/manifest_draft.hpp"
 #include "wheelins/io/odometer.hpp"
 #include "wheelins/io/ros/messages.hpp"
 #include "wheelins/io/text_util.hpp"
@@ -154,7 +153,7 @@ std::vector<TruthRecord> Importer::truth_records(std::vector<std::pair<double, P
     res.facts.push_back("truth velocity: central differences of the positions (the topic has no twist)");
   }
   if (!o_.origin) {
-    res.draft.todo.push_back("the truth was placed at the placeholder origin 0 deg, 0 deg, 0 m: give "
+    res.todo.push_back("the truth was placed at the placeholder origin 0 deg, 0 deg, 0 m: give "
                              "--origin LAT,LON,H (the geodetic position of the truth frame's origin) and "
                              "import again (gravity and the earth rate depend on it)");
     if (o_.warn)
@@ -167,11 +166,9 @@ std::vector<TruthRecord> Importer::truth_records(std::vector<std::pair<double, P
 void Importer::apply_tf(ImportResult& res, const std::vector<Transform>& tf) const {
   std::map<std::string, const Transform*> parent_of;
   for (const auto& t : tf) parent_of[t.child] = &t;
-  Manifest& m = res.draft.manifest;
   for (const auto& imu : res.imu) {
     if (imu.frame_id.empty()) continue;
     Vec3 p = Vec3::Zero();
-    Mat3 R = Mat3::Identity();  // accumulates frame -> base rotation
     std::string f = imu.frame_id;
     bool found = f == o_.base_frame;
     for (int hops = 0; !found && hops < 64; ++hops) {
@@ -181,30 +178,14 @@ void Importer::apply_tf(ImportResult& res, const std::vector<Transform>& tf) con
       const Quat q(t.rotation[3], t.rotation[0], t.rotation[1], t.rotation[2]);
       const Vec3 tr(t.translation[0], t.translation[1], t.translation[2]);
       p = q.normalized() * p + tr;  // point in child -> point in parent
-      R = q.normalized().toRotationMatrix() * R;
       f = t.parent;
       found = f == o_.base_frame;
     }
     if (!found) continue;
-    for (std::size_t i = 0; i < m.modules.size(); ++i) {
-      if (m.modules[i].name != imu.module) continue;
-      m.modules[i].p_inV = kFrdToFlu * p;  // base_link is FLU (REP 103), the v-frame FRD
-      res.draft.notes.comments["modules[" + std::to_string(i) + "].position_v_m"] =
-          "from /tf_static: " + o_.base_frame + " -> " + imu.frame_id + " (x forward, y right, z down)";
-      res.facts.push_back(imu.module + ": position from /tf_static (" + o_.base_frame + " -> " +
-                          imu.frame_id + ")");
-    }
+    // base_link is FLU (REP 103), the v-frame FRD.
+    res.positions[imu.module] = TfPosition{kFrdToFlu * p, "/tf_static: " + o_.base_frame + " -> " + imu.frame_id};
+    res.facts.push_back(imu.module + ": position from /tf_static (" + o_.base_frame + " -> " + imu.frame_id + ")");
   }
-}
-
-
-/// Module kinds by name: "body", "base" or "chassis" -> a Body-IMU, else a Wheel-IMU.
-bool looks_like_body(const std::string& name) {
-  std::string s;
-  for (char c : name) s += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (s.find("wheel") != std::string::npos) return false;
-  return s.find("body") != std::string::npos || s.find("base") != std::string::npos ||
-         s.find("chassis") != std::string::npos;
 }
 
 ImportResult Importer::run() {
@@ -259,12 +240,22 @@ ImportResult Importer::run() {
   std::error_code ec;
   if (fs::exists(out_, ec) && !fs::is_directory(out_, ec))
     throw InputError(quote(out_) + ": is a file, expected the output directory");
+  if (fs::is_directory(out_, ec))
+    for (const auto& n : io_detail::sweep_stale_partials(out_))
+      if (o_.warn) o_.warn(quote(out_ / n) + ": removed, the temporary file of an import that was killed");
   if (fs::is_directory(out_, ec) && !fs::is_empty(out_, ec) && !o_.force)
     throw InputError(quote(out_) + ": is not empty (use --force to write into it)");
   fs::create_directories(out_, ec);
   if (ec) throw InputError(quote(out_) + ": cannot create: " + ec.message());
   const fs::path manifest_file = out_ / "manifest.yaml";
-  check_output_target(manifest_file, o_.force);
+  {
+    // Every output checked before the first is written; none may be the recording.
+    std::vector<OutputFile> outs{{manifest_file, "--out"}};
+    if (odo < ts.size()) outs.push_back({out_ / "odo.bin", "--out"});
+    if (truth < ts.size()) outs.push_back({out_ / "GINS.bin", "--out"});
+    for (const auto& tm : imus) outs.push_back({out_ / (tm.module + "_imu.bin"), "--out"});
+    check_output_files(outs, {{rec_, "the recording"}}, o_.force);
+  }
 
   std::vector<std::unique_ptr<ImuFileWriter>> writers;
   for (const auto& tm : imus) {
@@ -347,70 +338,16 @@ ImportResult Importer::run() {
     for (const auto& r : truth_records(poses, res)) truth_writer->write(r);
   }
 
-  // Everything read and valid: the files appear, then the manifest is drafted from them.
+  // Everything read and valid: the files appear together.
   for (auto& w : writers) w->commit();
   if (odo_writer) odo_writer->commit();
   if (truth_writer) truth_writer->commit();
-  std::vector<std::string> todo_extra = res.draft.todo;
-  try {
-    res.draft = draft_manifest(out_, manifest_file);
-  } catch (...) {
-    for (const auto& it : res.imu) fs::remove(it.file, ec);
-    if (res.odometer) fs::remove(res.odometer->file, ec);
-    if (res.truth) fs::remove(res.truth->file, ec);
-    throw;
-  }
-  ManifestDraft& d = res.draft;
-  d.todo.insert(d.todo.end(), todo_extra.begin(), todo_extra.end());
-  Manifest& man = d.manifest;
-  man.name = rec_.filename().string();
-  for (std::size_t k = 0; k < man.modules.size(); ++k) {
-    ModuleSpec& s = man.modules[k];
-    const std::string key = "modules[" + std::to_string(k) + "].";
-    for (const auto& it : res.imu)
-      if (it.module == s.name) d.notes.comments["modules[" + std::to_string(k) + "]"] = "topic " + it.topic;
-    if (looks_like_body(s.name)) {
-      s.kind = ModuleKind::kBody;
-      s.wheel_radius = 0.0;
-      s.lever_arm_inB = Vec3::Zero();
-      s.p_inV = Vec3::Zero();
-      for (const char* f : {"wheel_radius_m", "lever_arm_b_m", "axle_sign"}) d.notes.comments.erase(key + f);
-      d.notes.comments[key + "kind"] = "TODO: check (a Body-IMU by its name)";
-      d.notes.comments[key + "position_v_m"] = "TODO: measure (IMU centre in the v-frame)";
-      d.notes.comments[key + "mounting_deg"] = "TODO: measure (C_b^v as roll, pitch, yaw)";
-    } else {
-      d.notes.comments[key + "kind"] = "TODO: check (a Wheel-IMU unless its name says body/base/chassis)";
-    }
-  }
-  d.todo.push_back("modules: the kind of each (wheel or body) was guessed from its name; check it");
-  // The draft looked for the first motion in the first module's gyro taking every module for
-  // a wheel; with the kinds known, a Wheel-IMU's gyro tells it.
-  if (!(man.static_end > man.static_start))
-    for (const ModuleSpec& s : man.modules)
-      if (s.kind == ModuleKind::kWheel) {
-        if (const auto t = motion_from_wheel(man.resolve(s.file), man.static_start); t && *t - 0.5 - man.static_start >= 1.0) {
-          man.static_end = *t - 0.5;
-          d.notes.comments["static_period_s"] = "until 0.5 s before the first motion (wheel gyro of " + s.name + ")";
-          std::erase_if(d.todo, [](const std::string& x) { return x.rfind("static_period_s", 0) == 0; });
-          char buf[48];
-          std::snprintf(buf, sizeof buf, "static period %.2f s", man.static_end - man.static_start);
-          res.facts.push_back(buf + (" (wheel gyro of " + s.name + ")"));
-        }
-        break;
-      }
-  std::erase_if(d.facts, [](const std::string& x) { return x.find(" layout: ") != std::string::npos; });
-  d.facts.insert(d.facts.begin(), std::to_string(res.imu.size()) + " IMU module(s) from " +
-                                      std::to_string(res.imu.size()) + " sensor_msgs/Imu topic(s)");
+  res.facts.insert(res.facts.begin(), std::to_string(res.imu.size()) + " IMU module(s) from " +
+                                          std::to_string(res.imu.size()) + " sensor_msgs/Imu topic(s)");
   if (!transforms.empty()) apply_tf(res, transforms);
-  d.notes.header = {"drafted by `wheelins import` from " + fs::absolute(rec_).lexically_normal().string() +
-                        " (" + res.format + ")",
-                    "values marked 'TODO' are guesses: measure them before trusting results"};
-  save_manifest(man, manifest_file, d.notes);
-  res.manifest_file = manifest_file;
-  res.facts.insert(res.facts.begin(), d.facts.begin(), d.facts.end());
-  if (o_.warn && !d.todo.empty())
-    o_.warn(quote(manifest_file) + ": " + std::to_string(d.todo.size()) +
-            " items are placeholders (marked TODO): measure or check them before trusting results");
+  for (std::size_t i = 0; i < ts.size(); ++i)
+    if ((ts[i].kind == MessageKind::kOdometry || ts[i].kind == MessageKind::kPoseStamped) && i != truth && i != odo)
+      res.pose_topics.push_back(ts[i].name + " (" + ts[i].type + ")");
   return res;
 }
 

@@ -8,8 +8,10 @@
 //                          nav_msgs/Odometry or geometry_msgs/PoseStamped
 //   OUT/odo.bin            (--odometry TOPIC) t, forward speed (twist.linear.x) of a
 //                          nav_msgs/Odometry topic
-//   OUT/manifest.yaml      drafted as `wheelins manifest OUT` drafts it (io/manifest_draft.hpp);
-//                          module positions from /tf_static where it has the IMU frames
+//
+// The manifest is drafted above this layer (run/ros_dataset.hpp: the modules surveyed as
+// `wheelins manifest` surveys IMU files side by side); the import reports what it needs:
+// the module positions /tf_static states and the pose topics it did not import.
 //
 // Every message is checked: a header stamp of zero, stamps that do not increase within
 // a topic, and NaN or infinite values are InputErrors naming the file, the topic and the
@@ -20,13 +22,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "wheelins/io/diagnostics.hpp"
-#include "wheelins/io/manifest_draft.hpp"
 #include "wheelins/nav/earth.hpp"
+#include "wheelins/nav/types.hpp"
 
 namespace wheelins::ros {
 
@@ -64,13 +67,22 @@ struct ImportedTopic {
   double t_first = 0.0, t_last = 0.0;
 };
 
+/// A module's position from /tf_static.
+struct TfPosition {
+  Vec3 p_inV = Vec3::Zero();  ///< [m] v-frame (x forward, y right, z down)
+  std::string chain;          ///< "/tf_static: base_link -> left_wheel_imu"
+};
+
 struct ImportResult {
   std::string format;  ///< the recording's format
   std::vector<ImportedTopic> imu;
   std::optional<ImportedTopic> truth, odometer;
-  std::filesystem::path manifest_file;
-  ManifestDraft draft;
+  std::map<std::string, TfPosition> positions;  ///< by module name
+  /// nav_msgs/Odometry and geometry_msgs/PoseStamped topics not imported ("name (type)"):
+  /// candidates for --truth.
+  std::vector<std::string> pose_topics;
   std::vector<std::string> facts;  ///< what the import found (tf positions, conventions)
+  std::vector<std::string> todo;   ///< what the import left to the user (a placeholder origin)
 };
 
 /// The module name a topic gets: the topic without its leading '/', other '/' and

@@ -2,13 +2,13 @@
 // checked by their CRC-32, a truncated file reported with the record's offset.
 #include "wheelins/io/ros/mcap.hpp"
 
-#include <lz4frame.h>
 #include <zstd.h>
 
 #include <array>
 #include <cstring>
 #include <stdexcept>
 
+#include "wheelins/io/ros/decompress.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins::ros {
@@ -36,12 +36,6 @@ const char* op_name(std::uint8_t op) {
   }
 }
 
-std::uint64_t le(const std::uint8_t* p, int n) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < n; ++i) v |= std::uint64_t(p[i]) << (8 * i);
-  return v;
-}
-
 /// Bounds-checked little-endian fields of one record's content.
 struct Cursor {
   const std::uint8_t* p;
@@ -55,9 +49,9 @@ struct Cursor {
     pos += k;
     return r;
   }
-  std::uint16_t u16(const char* f) { return static_cast<std::uint16_t>(le(take(2, f), 2)); }
-  std::uint32_t u32(const char* f) { return static_cast<std::uint32_t>(le(take(4, f), 4)); }
-  std::uint64_t u64(const char* f) { return le(take(8, f), 8); }
+  std::uint16_t u16(const char* f) { return static_cast<std::uint16_t>(read_le(take(2, f), 2)); }
+  std::uint32_t u32(const char* f) { return static_cast<std::uint32_t>(read_le(take(4, f), 4)); }
+  std::uint64_t u64(const char* f) { return read_le(take(8, f), 8); }
   std::string str(const char* f) {
     const std::uint32_t k = u32(f);
     const std::uint8_t* s = take(k, f);
@@ -85,60 +79,28 @@ std::uint32_t crc32(const std::uint8_t* data, std::size_t size, std::uint32_t cr
 }
 
 McapReader::McapReader(const fs::path& file, std::uint64_t max_chunk_bytes)
-    : name_("'" + file.string() + "'"), max_chunk_(max_chunk_bytes) {
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) throw InputError(name_ + ": is a directory, expected an .mcap file");
-  fp_ = std::fopen(file.c_str(), "rb");
-  if (!fp_) throw InputError(name_ + ": cannot open: " + std::strerror(errno));
-  const auto size = fs::file_size(file, ec);
-  if (ec) throw InputError(name_ + ": cannot read its size: " + ec.message());
-  size_ = size;
+    : src_(file, "an .mcap file"), max_chunk_(max_chunk_bytes) {
   start();
 }
 
 McapReader::McapReader(std::string name, const std::uint8_t* data, std::size_t size,
                        std::uint64_t max_chunk_bytes)
-    : name_(std::move(name)), mem_(data), size_(size), max_chunk_(max_chunk_bytes) {
+    : src_(std::move(name), data, size), max_chunk_(max_chunk_bytes) {
   start();
-}
-
-McapReader::~McapReader() {
-  if (fp_) std::fclose(fp_);
-}
-
-void McapReader::fail(std::uint64_t offset, const std::string& what) const {
-  throw InputError(name_ + ": byte " + std::to_string(offset) + ": " + what);
-}
-
-bool McapReader::read_bytes(std::uint8_t* out, std::size_t n) {
-  if (n > size_ - pos_) return false;
-  if (n == 0) return true;  // (an empty record: out may be null)
-  if (mem_) {
-    std::memcpy(out, mem_ + pos_, n);
-  } else if (std::fread(out, 1, n, fp_) != n) {
-    fail(pos_, "read error");
-  }
-  pos_ += n;
-  return true;
-}
-
-void McapReader::skip(std::uint64_t n) {
-  if (fp_ && std::fseek(fp_, static_cast<long>(pos_ + n), SEEK_SET) != 0) fail(pos_, "seek error");
-  pos_ += n;
 }
 
 void McapReader::start() {
   std::uint8_t magic[8];
-  if (!read_bytes(magic, 8) || std::memcmp(magic, kMagic, 8) != 0)
+  if (!src_.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0)
     fail(0, "not an MCAP file (no magic \\x89MCAP0\\r\\n at the start)");
   std::uint8_t head[kRecordHead];
-  const std::uint64_t at = pos_;
-  if (!read_bytes(head, kRecordHead) || head[0] != kHeader)
+  const std::uint64_t at = src_.pos();
+  if (!src_.read(head, kRecordHead) || head[0] != kHeader)
     fail(at, "the first record is not a Header record (opcode 0x01)");
-  const std::uint64_t len = le(head + 1, 8);
-  if (len > size_ - pos_) fail(at, "Header record of " + std::to_string(len) + " bytes runs past the end of the file");
+  const std::uint64_t len = read_le(head + 1, 8);
+  if (len > src_.left()) fail(at, "Header record of " + std::to_string(len) + " bytes runs past the end of the file");
   record_.resize(len);
-  read_bytes(record_.data(), len);
+  src_.read(record_.data(), len);
   McapMessage unused;
   record(kHeader, record_.data(), len, at, false, unused);
 }
@@ -220,30 +182,8 @@ void McapReader::chunk(const std::uint8_t* p, std::size_t n, std::uint64_t offse
     if (ZSTD_isError(got)) fail(offset, std::string("zstd Chunk does not decompress: ") + ZSTD_getErrorName(got));
     if (got != size) fail(offset, "zstd Chunk gives " + std::to_string(got) + " bytes, declares " + std::to_string(size));
   } else if (compression == "lz4") {
-    LZ4F_dctx* ctx = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) fail(offset, "lz4: out of memory");
-    std::size_t in_pos = 0, out_pos = 0;
-    std::size_t hint = 1;
-    std::string err;
-    while (hint != 0 && in_pos < k) {
-      std::size_t dst = size - out_pos, srcn = k - in_pos;
-      hint = LZ4F_decompress(ctx, chunk_.data() + out_pos, &dst, src + in_pos, &srcn, nullptr);
-      if (LZ4F_isError(hint)) {
-        err = LZ4F_getErrorName(hint);
-        break;
-      }
-      in_pos += srcn;
-      out_pos += dst;
-      if (dst == 0 && srcn == 0) {
-        err = "no progress (the frame is longer than the declared size)";
-        break;
-      }
-    }
-    LZ4F_freeDecompressionContext(ctx);
+    const std::string err = lz4_frame_decompress(src, k, chunk_.data(), size);
     if (!err.empty()) fail(offset, "lz4 Chunk does not decompress: " + err);
-    if (hint != 0) fail(offset, "lz4 Chunk ends inside its frame (truncated?)");
-    if (out_pos != size)
-      fail(offset, "lz4 Chunk gives " + std::to_string(out_pos) + " bytes, declares " + std::to_string(size));
   } else {
     fail(offset, "Chunk compression '" + compression + "' is not supported (expected none, zstd or lz4)");
   }
@@ -266,7 +206,7 @@ bool McapReader::next(McapMessage& out) {
         fail(chunk_offset_, "Chunk ends inside a record header (byte " + std::to_string(chunk_pos_) +
                                 " of its records)");
       const std::uint8_t op = chunk_[chunk_pos_];
-      const std::uint64_t len = le(&chunk_[chunk_pos_ + 1], 8);
+      const std::uint64_t len = read_le(&chunk_[chunk_pos_ + 1], 8);
       const std::size_t body = chunk_pos_ + kRecordHead;
       if (len > chunk_.size() - body)
         fail(chunk_offset_, std::string(op_name(op)) + " record at byte " + std::to_string(chunk_pos_) +
@@ -279,31 +219,31 @@ bool McapReader::next(McapMessage& out) {
       continue;
     }
     if (done_) return false;
-    const std::uint64_t at = pos_;
+    const std::uint64_t at = src_.pos();
     std::uint8_t head[kRecordHead];
-    if (!read_bytes(head, kRecordHead)) {
-      if (size_ - pos_ == 0)
+    if (!src_.read(head, kRecordHead)) {
+      if (src_.left() == 0)
         fail(at, "the file ends without a DataEnd or Footer record (truncated: was the recorder "
                  "stopped before it closed the file?)");
       fail(at, "the file ends inside a record header (truncated?)");
     }
     const std::uint8_t op = head[0];
-    const std::uint64_t len = le(head + 1, 8);
-    if (len > size_ - pos_)
+    const std::uint64_t len = read_le(head + 1, 8);
+    if (len > src_.left())
       fail(at, std::string(op_name(op)) + " record of " + std::to_string(len) + " bytes runs past the end of the file (" +
-                   std::to_string(size_ - pos_) + " bytes left; truncated?)");
+                   std::to_string(src_.left()) + " bytes left; truncated?)");
     if (op == kDataEnd || op == kFooter) {
       done_ = true;  // the summary that may follow repeats what the data section had
       return false;
     }
     if (op != kSchema && op != kChannel && op != kMessage && op != kChunk) {
-      skip(len);  // attachments, metadata, index records: not needed
+      src_.skip(len);  // attachments, metadata, index records: not needed
       continue;
     }
     if (op == kChunk && len > max_chunk_ + (1u << 20))
       fail(at, "Chunk record of " + std::to_string(len) + " bytes is larger than this reader accepts");
     record_.resize(len);
-    read_bytes(record_.data(), len);
+    src_.read(record_.data(), len);
     if (record(op, record_.data(), len, at, false, out)) return true;
   }
 }

@@ -30,6 +30,8 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/io/ros/byte_source.hpp"
+
 namespace wheelins::ros {
 
 struct McapSchema {
@@ -59,7 +61,6 @@ class McapReader {
   /// Reads a file held in memory (the bytes must outlive the reader); `name` is used in messages.
   McapReader(std::string name, const std::uint8_t* data, std::size_t size,
              std::uint64_t max_chunk_bytes = 1ull << 30);
-  ~McapReader();
   McapReader(const McapReader&) = delete;
   McapReader& operator=(const McapReader&) = delete;
 
@@ -69,23 +70,17 @@ class McapReader {
   const std::map<std::uint16_t, McapSchema>& schemas() const { return schemas_; }
   const std::map<std::uint16_t, McapChannel>& channels() const { return channels_; }
   const std::string& profile() const { return profile_; }
-  const std::string& name() const { return name_; }
+  const std::string& name() const { return src_.name(); }
 
  private:
   void start();
-  /// Fills `out` with n bytes from the file; false (nothing read) at a clean end.
-  bool read_bytes(std::uint8_t* out, std::size_t n);
-  void skip(std::uint64_t n);  ///< n <= size_ - pos_
-  [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const;
+  [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const { src_.fail(offset, what); }
   /// Handles one record; true if it was a message (then `out` is set).
   bool record(std::uint8_t op, const std::uint8_t* p, std::size_t n, std::uint64_t offset,
               bool in_chunk, McapMessage& out);
   void chunk(const std::uint8_t* p, std::size_t n, std::uint64_t offset);
 
-  std::string name_;
-  std::FILE* fp_ = nullptr;
-  const std::uint8_t* mem_ = nullptr;
-  std::uint64_t size_ = 0, pos_ = 0;
+  ByteSource src_;
   std::uint64_t max_chunk_;
   std::vector<std::uint8_t> record_, chunk_;
   std::size_t chunk_pos_ = 0;
