@@ -182,6 +182,14 @@ TEST(FaultHandler, DetectorIsolatesWhenOthersCanTakeOverAndOnlyReportsALoneModul
     EXPECT_FALSE(h->tied(2));
     EXPECT_EQ(h->monitor().stats(2).isolations, 1u);
     EXPECT_TRUE(has_event(h->monitor(), "body", "velocity innovations inconsistent"));
+    // Still inconsistent while isolated (two others healthy): nothing more is said, and above
+    // all not that nobody could take over.
+    const std::size_t events = h->monitor().events().size();
+    for (int k = 1; k <= 2 * o.max_failed; ++k)
+      h->on_velocity_update(2, report(2 * o.test_ratio), kT0 + o.max_failed + 0.1 * k);
+    EXPECT_EQ(h->monitor().health(2), Health::kIsolated);
+    EXPECT_EQ(h->monitor().events().size(), events);
+    EXPECT_EQ(h->monitor().stats(2).isolations, 1u);
     // Retried after retry_after: re-levelled, then restarted.
     h->on_velocity_step(kT0 + o.max_failed + o.retry_after);
     EXPECT_EQ(h->monitor().health(2), Health::kRealign);

@@ -2,6 +2,7 @@
 // and restarts, saturation, slip, the innovation detector, the heading check.
 #include "wheelins/fusion/fault_handler.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -14,6 +15,32 @@ std::vector<std::string> names_of(const Subsystems& subs) {
   return names;
 }
 }  // namespace
+
+void FaultHandler::finish(double t) {
+  monitor_.finish(t);
+  for (int i = 0; i < monitor_.size(); ++i) {
+    const Evidence& e = evidence_[static_cast<std::size_t>(i)];
+    char what[256];
+    if (e.rotation >= kEvidenceRotation && e.about_axle < kMinAxleShare * e.rotation) {
+      std::snprintf(what, sizeof what,
+                    "only %.0f %% of its gyro's rotation (%.0f rad) was about the axle the manifest gives "
+                    "(its b-frame x)",
+                    100.0 * e.about_axle / e.rotation, e.rotation);
+      monitor_.warn(i, t, what,
+                    "the wheel spins about another sensor axis: check its axle_axis and mounting_deg (the "
+                    "data checks before a run test them); this run's solution is not to be trusted");
+    }
+    const double rolled = e.forward + e.backward;
+    if (rolled >= kEvidenceDistance && e.backward > kMaxBackwardShare * rolled) {
+      std::snprintf(what, sizeof what, "its wheel rolled backward for %.0f %% of its %.0f m",
+                    100.0 * e.backward / rolled, rolled);
+      monitor_.warn(i, t, what,
+                    "a vehicle drives forward most of its way: its axle_sign looks reversed (the data "
+                    "checks before a run test it); unless it really drove backward, this run's solution "
+                    "is not to be trusted");
+    }
+  }
+}
 
 std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, Subsystems& subs,
                                                  FilterBackend& filter, OutputFusion& output) {
@@ -73,7 +100,9 @@ void FaultPolicy::screen_speeds(double t, const std::array<WheelVelocityInput, k
     }
     if (t - rt_[i].saturated_until < opt_.retry_after) excused_[i] = true;
   }
-  // Agreeing with the other wheels and the wheel's own INS (slip, a lifted wheel).
+  // Rolling with the others (a reversed axle), then agreeing with the other wheels and the
+  // wheel's own INS (slip, a lifted wheel).
+  check_directions(t, wheel, sel.speed_ok);
   check_wheel_speeds(t, wheel, sel.speed_ok);
   // Every wheel saturated or recovering: the innovations they cause are explained, and no
   // module is blamed for them.
@@ -91,12 +120,18 @@ void FaultPolicy::on_velocity_update(int i, const UpdateReport& rep, double t_no
   std::snprintf(what, sizeof what,
                 "velocity innovations inconsistent: %d of the last %d test ratios over %.1f",
                 opt_.max_failed, opt_.window, opt_.test_ratio);
+  // An isolated module navigates alone until its retry: it is already out of everything the
+  // others use, and its own innovations say nothing new.
+  if (!monitor_.tied(i)) return;
   const int others_ok = monitor_.count_ok() - (monitor_.counts(i) ? 1 : 0);
-  if (subs_.size() > 1 && others_ok >= 1 && monitor_.tied(i)) {
+  if (others_ok >= 1) {
     isolate(i, t_now, what);
   } else if (!rt_[i].detector_fired) {
     rt_[i].detector_fired = true;
-    monitor_.note(i, t_now, what, "no other module to take over: kept (reported once)");
+    monitor_.note(i, t_now, what,
+                  subs_.size() == 1
+                      ? "no other module to take over: kept (reported once)"
+                      : "no other module in good health to take over: kept (reported once)");
   }
 }
 
@@ -195,12 +230,10 @@ void FaultPolicy::check_wheel_speeds(double t, const std::array<WheelVelocityInp
   for (int i = 0; i < n; ++i) {
     if (!speed_ok[i] || !subs_.is_wheel(i)) continue;
     // The vehicle's forward speeds (a steered wheel's along itself times cos(steering)).
-    const double vi = own[i].measured_speed * std::cos(own[i].steering), yi = subs_[i].module().p_inV.y();
+    const double vi = own[i].measured_speed * std::cos(own[i].steering);
     double pred = 0.0;
     for (int j = 0; j < n; ++j)
-      if (j != i && speed_ok[j] && subs_.is_wheel(j))
-        pred += own[j].measured_speed * std::cos(own[j].steering) -
-                yaw_rate * (yi - subs_[j].module().p_inV.y());
+      if (j != i && speed_ok[j] && subs_.is_wheel(j)) pred += speed_at(i, j, own, yaw_rate);
     pred /= n_u - 1;
     bool disagrees = z[i] > opt_.speed_gate &&
                      std::abs(vi - pred) > std::max(opt_.wheel_mismatch, 0.1 * std::abs(pred));
@@ -229,6 +262,92 @@ void FaultPolicy::check_wheel_speeds(double t, const std::array<WheelVelocityInp
   }
 }
 
+double FaultPolicy::speed_at(int i, int j, const std::array<WheelVelocityInput, kMaxModules>& own,
+                             double yaw_rate) const {
+  return own[j].measured_speed * std::cos(own[j].steering) -
+         yaw_rate * (subs_[i].module().p_inV.y() - subs_[j].module().p_inV.y());
+}
+
+void FaultPolicy::check_directions(double t, const std::array<WheelVelocityInput, kMaxModules>& own,
+                                   std::array<bool, kMaxModules>& speed_ok) {
+  // A wheel whose speed has the other sign than the vehicle's motion at its place (the other
+  // wheels' speeds moved there with the yaw rate), both above reverse_speed, conflicts with
+  // them. The wheel in conflict with the most is outvoted; between equals (two wheels), the
+  // body's inertial speed decides once it is above reverse_speed,
+  // and without a body the one rolling backward is suspected (a vehicle drives forward most
+  // of its way). A suspect's speed is not used; a suspect for reverse_time in a row is isolated for the rest of the run (its axle_sign is reversed: a retry would not
+  // mend it). A slip is not mistaken for it: a slipping wheel turns faster the same way.
+  const double dt = direction_t_ > -1e300 ? t - direction_t_ : 0.0;
+  direction_t_ = t;
+  const int n = subs_.size();
+  const double vmin = opt_.reverse_speed;
+  std::array<bool, kMaxModules> cand{};
+  double yaw_rate = 0.0;
+  int n_c = 0;
+  for (int i = 0; i < n; ++i)
+    if (speed_ok[i] && subs_.is_wheel(i) && monitor_.counts(i)) {
+      cand[i] = true;
+      yaw_rate += subs_.wheel(i).vehicle_yaw_rate();
+      ++n_c;
+    }
+  std::array<int, kMaxModules> conflicts{};
+  int most = 0;
+  if (n_c >= 2) {
+    yaw_rate /= n_c;
+    for (int i = 0; i < n; ++i) {
+      const double vi = own[i].measured_speed * std::cos(own[i].steering);
+      if (!cand[i] || std::abs(vi) < vmin) continue;
+      for (int j = 0; j < n; ++j) {
+        if (j == i || !cand[j]) continue;
+        const double vj = speed_at(i, j, own, yaw_rate);
+        if (std::abs(vj) >= vmin && (vi > 0.0) != (vj > 0.0)) ++conflicts[i];
+      }
+      most = std::max(most, conflicts[i]);
+    }
+  }
+  int n_most = 0;
+  for (int i = 0; i < n; ++i) n_most += most > 0 && conflicts[i] == most;
+  const bool body = subs_.has_body() && monitor_.counts(subs_.body_index());
+  const double v_body = body ? subs_.body().ins_speed() : 0.0;
+  for (int i = 0; i < n; ++i) {
+    Runtime& rt = rt_[i];
+    if (most == 0 || conflicts[i] != most) {
+      rt.reverse_time = 0.0;
+      continue;
+    }
+    const double vi = own[i].measured_speed * std::cos(own[i].steering);
+    const double vb = v_body - yaw_rate * subs_[i].module().p_inV.y();
+    bool suspect = n_most == 1;
+    if (!suspect) suspect = std::abs(vb) >= vmin ? (vi > 0.0) != (vb > 0.0) : vi < 0.0;
+    rt.reverse_time = suspect ? rt.reverse_time + dt : 0.0;
+    if (suspect) speed_ok[i] = false;
+    if (rt.reverse_time + 1e-9 < opt_.reverse_time) continue;
+    if (monitor_.count_ok() - 1 < 1) continue;  // nobody to take over: reported at the end
+    double others = 0.0;
+    int n_o = 0;
+    for (int j = 0; j < n; ++j)
+      if (j != i && cand[j]) {
+        others += speed_at(i, j, own, yaw_rate);
+        ++n_o;
+      }
+    char what[256];
+    std::snprintf(what, sizeof what,
+                  "rolls against the vehicle's motion for %.1f s: its speed %+.2f m/s, the other wheels' "
+                  "%+.2f m/s at its place%s",
+                  rt.reverse_time, vi, n_o ? others / n_o : 0.0,
+                  std::abs(vb) >= vmin && body ? (std::string(", the body's ") +
+                                                  (vb > 0.0 ? "forward" : "backward")).c_str()
+                                               : "");
+    isolate(i, t, what);
+    rt.reversed = true;
+    monitor_.note(i, t, "its axle_sign looks reversed",
+                  "isolated for the rest of the run: check its axle_sign (the data checks before a run test it)");
+    // The others' failed tests while it disagreed were its doing.
+    for (int j = 0; j < n; ++j)
+      if (j != i) monitor_.clear_tests(j);
+  }
+}
+
 void FaultPolicy::on_velocity_step(double t) {
   for (int i = 0; i < subs_.size(); ++i) {
     Runtime& rt = rt_[i];
@@ -246,7 +365,7 @@ void FaultPolicy::on_velocity_step(double t) {
     if (h == Health::kProbation && t - monitor_.since(i) >= opt_.probation)
       monitor_.transition(i, Health::kOk, t, "probation passed",
                          "back in the fused solution");
-    else if (h == Health::kIsolated && t - monitor_.since(i) >= opt_.retry_after)
+    else if (h == Health::kIsolated && !rt.reversed && t - monitor_.since(i) >= opt_.retry_after)
       begin_realign(i, t, "retry after isolation", "re-levelling, then restarting from the others");
   }
 }

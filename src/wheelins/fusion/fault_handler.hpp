@@ -21,6 +21,7 @@
 // FaultMonitor (fault_monitor.hpp) keeps the health state machine and the report.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -61,12 +62,41 @@ class FaultHandler {
   }
   /// A position-constraint step begins at time t.
   virtual void on_position_step(double /*t*/) {}
-  /// The data end at time t.
-  virtual void finish(double t) { monitor_.finish(t); }
+  /// The data end at time t: the statistics closed, and the evidence against a wheel's
+  /// geometry (below) reported as warnings.
+  virtual void finish(double t);
+
+  /// Evidence against the manifest's wheel geometry, gathered with or without fault handling
+  /// (for a run whose data checks were off, or a lone wheel nothing can be compared with):
+  /// Wheel-IMU i's navigated sample (b-frame): its rotation about the axle against all of it.
+  void tally_rotation(int i, const ImuSample& b) {
+    Evidence& e = evidence_[static_cast<std::size_t>(i)];
+    e.about_axle += std::abs(b.dtheta.x());
+    e.rotation += b.dtheta.norm();
+  }
+  /// Wheel i's own signed speed at a velocity-update step, held for dt: the distance it rolled
+  /// forward and backward.
+  void tally_speed(int i, double speed, double dt) {
+    Evidence& e = evidence_[static_cast<std::size_t>(i)];
+    (speed >= 0.0 ? e.forward : e.backward) += std::abs(speed) * dt;
+  }
+  /// The evidence is reported from this much rotation [rad] / distance [m] on.
+  static constexpr double kEvidenceRotation = 60.0, kEvidenceDistance = 20.0;
+  /// ... when the axle's share of the rotation is below this, or the backward share of the
+  /// distance above this.
+  static constexpr double kMinAxleShare = 0.5, kMaxBackwardShare = 0.7;
 
  protected:
-  explicit FaultHandler(FaultMonitor monitor) : monitor_(std::move(monitor)) {}
+  explicit FaultHandler(FaultMonitor monitor)
+      : monitor_(std::move(monitor)), evidence_(static_cast<std::size_t>(monitor_.size())) {}
   FaultMonitor monitor_;
+
+ private:
+  struct Evidence {
+    double about_axle = 0.0, rotation = 0.0;  ///< [rad]
+    double forward = 0.0, backward = 0.0;     ///< [m]
+  };
+  std::vector<Evidence> evidence_;
 };
 
 /// Fault handling off: every sample and module is used as it comes.
@@ -107,12 +137,20 @@ class FaultPolicy final : public FaultHandler {
     double snapshot_t = -1e300;
     bool have_snapshot = false;
     bool revert_errors = false;      ///< restart from errors_old (after an isolation)
+    double reverse_time = 0.0;       ///< [s] rolling against the vehicle's motion, in a row
+    bool reversed = false;           ///< isolated for rolling against it: not retried
   };
   void watch_outages(int index, double t);
   void handle_saturation(int index, const ImuSample& raw, ImuSample& b);
   bool substitute_speed(int wheel_index, double* speed) const;
   void check_wheel_speeds(double t, const std::array<WheelVelocityInput, kMaxModules>& own,
                           std::array<bool, kMaxModules>& speed_ok);
+  /// A wheel rolling against the vehicle's motion (a reversed axle_sign): isolated for the run.
+  void check_directions(double t, const std::array<WheelVelocityInput, kMaxModules>& own,
+                        std::array<bool, kMaxModules>& speed_ok);
+  /// Wheel j's forward speed moved to wheel i's place with the yaw rate (v-frame y to the
+  /// right): v_i = v_j - yaw_rate (y_i - y_j); a steered wheel's along itself times cos(steering).
+  double speed_at(int i, int j, const std::array<WheelVelocityInput, kMaxModules>& own, double yaw_rate) const;
   void isolate(int i, double t, const std::string& what);
   void begin_realign(int i, double t, const std::string& what, const std::string& action);
   /// Where module i restarts at time t: the others' fused solution (or its own, alone).
@@ -125,6 +163,7 @@ class FaultPolicy final : public FaultHandler {
   OutputFusion& output_;
   std::vector<Runtime> rt_;
   bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
+  double direction_t_ = -1e300;  ///< the last direction check
   std::array<bool, kMaxModules> excused_{};  ///< saturated or recovering this step
 };
 

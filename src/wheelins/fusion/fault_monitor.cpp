@@ -25,6 +25,9 @@ void FaultOptions::validate() const {
   positive(test_ratio, "test_ratio");
   positive(saturation_hold, "saturation_hold_s");
   positive(heading_gate, "heading_gate_deg");
+  positive(max_outage, "max_outage_s");
+  positive(reverse_speed, "reverse_speed_m_s");
+  positive(reverse_time, "reverse_time_s");
   if (heading_epochs < 1)
     throw InputError("faults.heading_epochs: must be >= 1, got " + std::to_string(heading_epochs));
   if (!(saturation_margin > 0.0 && saturation_margin <= 1.0))
@@ -39,8 +42,9 @@ void FaultOptions::validate() const {
 }
 
 std::string FaultOptions::describe() const {
-  if (!enabled) return "fault handling:             off\n";
   std::ostringstream o;
+  o << "longest outage bridged:     " << max_outage << " s without data from any module (longer: an error)\n";
+  if (!enabled) return o.str() + "fault handling:             off\n";
   o << "fault handling:             on: out after " << stale_after << " s without data, gap > "
     << max_gap << " s, realign " << realign_time << " s, probation " << probation << " s\n"
     << "fault detector:             " << max_failed << " of " << window
@@ -49,7 +53,9 @@ std::string FaultOptions::describe() const {
     << heading_epochs << " epochs (3+ modules)\n"
     << "wheel speed check:          " << speed_gate << " sigma from its INS and "
     << wheel_mismatch << " m/s (or 10 %) from the other wheels; saturation at "
-    << saturation_margin * 100 << " % of full scale, held " << saturation_hold << " s\n";
+    << saturation_margin * 100 << " % of full scale, held " << saturation_hold << " s\n"
+    << "wheel direction check:      a wheel rolling against the others (and the body) above "
+    << reverse_speed << " m/s for " << reverse_time << " s is isolated for the run\n";
   return o.str();
 }
 
@@ -83,6 +89,11 @@ void FaultMonitor::note(int i, double t, const std::string& what, const std::str
     return;
   }
   events_.push_back({t, modules_[i].name, what, action});
+}
+
+void FaultMonitor::warn(int i, double t, const std::string& what, const std::string& action) {
+  note(i, t, what, action);
+  warnings_.push_back("module '" + modules_[i].name + "': " + what + ": " + action);
 }
 
 void FaultMonitor::transition(int i, Health h, double t, const std::string& what,
@@ -166,9 +177,9 @@ std::string fault_report_text(const FaultMonitor& m) {
     o << "faults: " << ev.size() << " event" << (ev.size() == 1 ? "" : "s") << '\n';
     const std::size_t shown = ev.size() <= 20 ? ev.size() : 20;
     for (std::size_t k = 0; k < shown; ++k) {
-      std::snprintf(buf, sizeof buf, "  t=%.2f %-10s %s -> %s\n", ev[k].t, ev[k].module.c_str(),
-                    ev[k].what.c_str(), ev[k].action.c_str());
-      o << buf;
+      // (The texts may be longer than any buffer: only the time and the name are formatted.)
+      std::snprintf(buf, sizeof buf, "  t=%.2f %-10s ", ev[k].t, ev[k].module.c_str());
+      o << buf << ev[k].what << " -> " << ev[k].action << '\n';
     }
     if (shown < ev.size()) o << "  ... " << ev.size() - shown << " more in faults.csv\n";
   }

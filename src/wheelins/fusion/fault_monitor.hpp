@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/nav/types.hpp"
+
 namespace wheelins {
 
 struct FaultOptions {
@@ -39,11 +41,26 @@ struct FaultOptions {
   int heading_epochs = 5;           ///< constraint epochs in a row off by more: isolated
   double saturation_margin = 0.995; ///< |gyro| >= margin * full scale is saturated
   double saturation_hold = 0.1;     ///< [s] a saturated wheel's speed stays unused this long after
+  /// [s] no data from any module for longer ends the run with an OutageError (with or without
+  /// fault handling): the motion across it is unknown, and extrapolating it is no answer.
+  double max_outage = 10.0;
+  double reverse_speed = 0.3;       ///< [m/s] wheel speeds compared in sign from this speed on
+  double reverse_time = 2.0;        ///< [s] a wheel rolling against the others this long is isolated
 
   /// Throws InputError naming the option if a value is out of range.
   void validate() const;
   /// One line per option, in human units.
   std::string describe() const;
+};
+
+/// No data from any module for longer than FaultOptions::max_outage: the navigation cannot go
+/// on. `module` (its index in the navigator) is the one whose sample came after the gap.
+class OutageError : public InputError {
+ public:
+  OutageError(const std::string& what, int module, double t_before, double t_after)
+      : InputError(what), module(module), t_before(t_before), t_after(t_after) {}
+  int module;
+  double t_before, t_after;
 };
 
 enum class Health { kOk, kOut, kRealign, kProbation, kIsolated };
@@ -98,6 +115,10 @@ class FaultMonitor {
   void transition(int i, Health h, double t, const std::string& what, const std::string& action);
   /// Records an event without a change of health (e.g. saturation starts).
   void note(int i, double t, const std::string& what, const std::string& action);
+  /// Records an event that the run also prints as a warning (warnings()).
+  void warn(int i, double t, const std::string& what, const std::string& action);
+  /// One line per warn(), naming the module.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
   /// One velocity test of module i; true when the detector declares it faulty
   /// (max_failed of the last `window` tests over the threshold).
@@ -126,6 +147,7 @@ class FaultMonitor {
   FaultOptions opt_;
   std::vector<Module> modules_;
   std::vector<FaultEvent> events_;
+  std::vector<std::string> warnings_;
   std::uint64_t dropped_ = 0;
 };
 

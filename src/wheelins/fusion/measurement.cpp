@@ -2,6 +2,7 @@
 // point, and the velocity (eq. 5, 6) and position-constraint (eq. 11) measurements.
 #include "wheelins/fusion/measurement.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace wheelins {
@@ -181,6 +182,43 @@ void position_measurement(const Subsystems& subs, const SharedInputs& sh, const 
   m.R = Mat3::Identity() * sd * sd;
   m.gate = o.position_gate;
   m.H_own = sh.ref[i].H;
+}
+
+namespace {
+ZeroMotionInput zero_motion_input(const Subsystem& s, const Vec3& mean_raw_rate) {
+  const StrapdownEkf& ekf = s.ekf();
+  ZeroMotionInput in;
+  in.C_BtoW = ekf.state().C_ItoW();
+  in.v_IinW = ekf.state().v_IinW;
+  const ImuErrors& e = ekf.errors();
+  in.omega_ib_b = (mean_raw_rate - e.bg).cwiseQuotient(Vec3::Ones() + e.sg);  // as compensate()
+  in.omega_ie_inW = ekf.mechanization().omega_ie_inW;
+  return in;
+}
+}  // namespace
+
+void zero_velocity_measurement(const Subsystems& subs, int i, double velocity_std, Measurement& m) {
+  m.reset(i, subs.size());
+  m.velocity = true;
+  const ZeroMotionModel z = zero_velocity_model(zero_motion_input(subs[i], Vec3::Zero()));
+  m.H[i] = z.H;
+  m.H_own = z.H;
+  m.dz = z.innovation();
+  m.R = Mat3::Identity() * velocity_std * velocity_std;
+  m.gate = 0.0;
+}
+
+void zero_rate_measurement(const Subsystems& subs, int i, const Vec3& mean_raw_rate, double window,
+                           double rate_std, Measurement& m) {
+  m.reset(i, subs.size());
+  m.velocity = true;
+  const ZeroMotionModel z = zero_rate_model(zero_motion_input(subs[i], mean_raw_rate));
+  m.H[i] = z.H;
+  m.H_own = z.H;
+  m.dz = z.innovation();
+  const double arw = subs[i].process_noise().gyro_arw;
+  m.R = Mat3::Identity() * (arw * arw / std::max(window, 1e-3) + rate_std * rate_std);
+  m.gate = 0.0;
 }
 
 }  // namespace wheelins

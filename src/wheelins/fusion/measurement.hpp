@@ -13,6 +13,7 @@
 
 #include <array>
 
+#include "wheelins/filter/zero_motion.hpp"
 #include "wheelins/fusion/subsystems.hpp"
 
 namespace wheelins {
@@ -119,5 +120,14 @@ void velocity_measurement(const Subsystems& subs, const SharedInputs& sh, const 
 /// the reference taken as an external position (the paper's distributed filter).
 void position_measurement(const Subsystems& subs, const SharedInputs& sh, const FusionOptions& o,
                           int i, Measurement& m);
+
+/// The measurements of subsystem i on a standing vehicle (filter/zero_motion.hpp), its own
+/// block only (H[i] = H_own): zero velocity of the IMU with sigma `velocity_std`; zero angular
+/// rate beyond the earth's, from `mean_raw_rate` (the mean raw b-frame rate over the standstill
+/// window of `window` seconds, compensated with the current estimates) with the gyro's white
+/// noise over the window and `rate_std` added in quadrature.
+void zero_velocity_measurement(const Subsystems& subs, int i, double velocity_std, Measurement& m);
+void zero_rate_measurement(const Subsystems& subs, int i, const Vec3& mean_raw_rate, double window,
+                           double rate_std, Measurement& m);
 
 }  // namespace wheelins
