@@ -4,10 +4,13 @@
 //   omega_hat = omega + b_g + diag(omega) s_g,  f_hat = f + b_a + diag(f) s_a.
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "wheelins/filter/body_velocity.hpp"
 #include "wheelins/filter/error_model.hpp"
 #include "wheelins/filter/position_constraint.hpp"
 #include "wheelins/filter/wheel_velocity.hpp"
+#include "wheelins/filter/zero_motion.hpp"
 #include "wheelins/nav/earth.hpp"
 
 using namespace wheelins;
@@ -72,6 +75,21 @@ Eigen::Matrix<double, 9, 1> error_rate(const NavTruth& t, const Vec21& dx, const
   return r;
 }
 
+/// Central differences of the innovation `innovation_at(dx)` over every error state, against H.
+template <class F>
+void expect_jacobian(const F& innovation_at, const Eigen::Matrix<double, 3, kStateDim>& H, const char* what) {
+  const double eps = 1e-6;
+  for (int j = 0; j < kStateDim; ++j) {
+    Vec21 dx = Vec21::Zero();
+    dx(j) = eps;
+    const Vec3 plus = innovation_at(dx);
+    dx(j) = -eps;
+    const Vec3 col = (plus - innovation_at(dx)) / (2 * eps);
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(col(i), H(i, j), 1e-6 * (1.0 + std::abs(H(i, j)))) << what << " H(" << i << "," << j << ")";
+  }
+}
+
 }  // namespace
 
 TEST(FilterJacobian, ErrorDynamicsMatchFiniteDifference) {
@@ -132,18 +150,8 @@ TEST(FilterJacobian, WheelVelocityMatchesFiniteDifference) {
     if (steering != 0.0) in0.vehicle_roll = 0.03, in0.vehicle_pitch = -0.02, in0.steering = steering;
     set_own_wheel_speed(in0, 0.097, mean_wx);
     const WheelVelocityModel m = wheel_velocity_model(in0);
-    const double eps = 1e-6;
-    for (int j = 0; j < kStateDim; ++j) {
-      Vec21 dx = Vec21::Zero();
-      dx(j) = eps;
-      const Vec3 plus = residual(dx);
-      dx(j) = -eps;
-      const Vec3 minus = residual(dx);
-      const Vec3 col = (plus - minus) / (2 * eps);
-      for (int i = 0; i < 3; ++i)
-        EXPECT_NEAR(col(i), m.H(i, j), 1e-6 * (1.0 + std::abs(m.H(i, j))))
-            << "axle " << axle_sign << " steering " << steering << " H(" << i << "," << j << ")";
-    }
+    const std::string what = "axle " + std::to_string(axle_sign) + " steering " + std::to_string(steering);
+    expect_jacobian(residual, m.H, what.c_str());
   }
 }
 
@@ -179,17 +187,8 @@ TEST(FilterJacobian, BodyVelocityMatchesFiniteDifference) {
     in.omega_ib_b = e.omega;
     return body_velocity_model(in);
   };
-  const auto m = model_at(Vec21::Zero());
-  const double eps = 1e-6;
-  for (int j = 0; j < kStateDim; ++j) {
-    Vec21 dx = Vec21::Zero();
-    dx(j) = eps;
-    const Vec3 plus = model_at(dx).innovation();
-    dx(j) = -eps;
-    const Vec3 col = (plus - model_at(dx).innovation()) / (2 * eps);
-    for (int i = 0; i < 3; ++i)
-      EXPECT_NEAR(col(i), m.H(i, j), 1e-6 * (1.0 + std::abs(m.H(i, j)))) << "H(" << i << "," << j << ")";
-  }
+  expect_jacobian([&](const Vec21& dx) { return model_at(dx).innovation(); }, model_at(Vec21::Zero()).H,
+                  "body velocity");
 }
 
 TEST(FilterJacobian, PositionConstraintMatchesFiniteDifference) {
@@ -229,6 +228,35 @@ TEST(FilterJacobian, PositionConstraintMatchesFiniteDifference) {
             << "kind " << kind << " H(" << i << "," << j << ")";
     }
   }
+}
+
+TEST(FilterJacobian, ZeroVelocityAndZeroRateMatchFiniteDifference) {
+  // A Wheel-IMU's attitude; an earth rate magnified (the model is linear in it) so that the
+  // attitude block is tested, a rate and a velocity away from zero so that every block is.
+  NavTruth t;
+  const Vec3 w_ie(0.3, -0.2, 0.5);
+  auto input_at = [&](const Vec21& dx) {
+    const Estimate e = perturb(t, dx);
+    ZeroMotionInput in;
+    in.C_BtoW = e.C;
+    in.v_IinW = e.v;
+    in.omega_ib_b = e.omega;
+    in.omega_ie_inW = w_ie;
+    return in;
+  };
+  for (int which : {0, 1}) {
+    auto model_at = [&](const Vec21& dx) {
+      return which == 0 ? zero_velocity_model(input_at(dx)) : zero_rate_model(input_at(dx));
+    };
+    expect_jacobian([&](const Vec21& dx) { return model_at(dx).innovation(); }, model_at(Vec21::Zero()).H,
+                    which == 0 ? "zero velocity" : "zero rate");
+  }
+  // At rest the true state predicts the measurement exactly: no velocity, and the gyro
+  // showing the earth's rotation only.
+  t.v.setZero();
+  t.omega = t.C.transpose() * w_ie;
+  EXPECT_NEAR(zero_velocity_model(input_at(Vec21::Zero())).innovation().norm(), 0.0, 1e-15);
+  EXPECT_NEAR(zero_rate_model(input_at(Vec21::Zero())).innovation().norm(), 0.0, 1e-15);
 }
 
 TEST(FilterJacobian, ReferencePointOfLevelWheelAndBody) {

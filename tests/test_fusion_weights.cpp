@@ -156,7 +156,10 @@ TEST(ReferenceWeights, RunConfigurationChoosesTheWeighting) {
   EXPECT_EQ(c.nav.fusion.weighting, ReferenceWeighting::kFixed);
   EXPECT_EQ(c.nav.fusion.weights, (std::vector<double>{1, 2}));
   iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: inverse}\n");
-  EXPECT_HAS(iotest::error_of([&] { load_run_config(cfg, {}); }), "fusion.weights: expected equal or covariance");
+  EXPECT_HAS(iotest::error_of([&] { load_run_config(cfg, {}); }),
+             "fusion.weights: expected equal, covariance or standalone");
+  iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: standalone}\n");
+  EXPECT_EQ(load_run_config(cfg, {}).nav.fusion.weighting, ReferenceWeighting::kStandalone);
   iotest::write_text(cfg, "dataset: m.yaml\nfusion: {weights: covariance, weight_window_epochs: 0}\n");
   EXPECT_HAS(iotest::error_of([&] { load_run_config(cfg, {}); }), "fusion.weight_window_epochs: must be in");
   EXPECT_THROW(weighting_from_name("x"), InputError);
@@ -165,4 +168,57 @@ TEST(ReferenceWeights, RunConfigurationChoosesTheWeighting) {
   n.fusion.weighting = ReferenceWeighting::kCovariance;
   n.fusion.weights = {1.0, 1.0};
   EXPECT_THROW(n.validate(), InputError);
+  n.fusion.weighting = ReferenceWeighting::kStandalone;
+  EXPECT_THROW(n.validate(), InputError);
+}
+
+// The constraint-free drift model against its closed forms at a constant speed v: the angle
+// random walk alone gives a lateral variance v^2 q t^3 / 3, a constant bias of variance s2
+// v^2 s2 t^4 / 4 (both the exact integrals of e' = v psi, psi' = b + w).
+TEST(StandaloneDrift, LateralVarianceMatchesTheClosedForms) {
+  const double v = 5.0, arw = 0.3 * kDeg / 60.0, T = 600.0;
+  StandaloneDrift a;
+  a.start(0.0, 0.0);
+  for (int k = 1; k <= 600; ++k) a.step(k * 1.0, v, arw, 0.0, 3600.0);
+  EXPECT_NEAR(a.lateral_variance() / (v * v * arw * arw * T * T * T / 3.0), 1.0, 2e-3);
+  StandaloneDrift b;
+  const double s = 10.0 * kDeg / 3600.0;
+  b.start(0.0, s * s);
+  b.step(T, v, 0.0, 0.0, 3600.0);  // one call, split into 1 s steps inside
+  EXPECT_NEAR(b.lateral_variance() / (v * v * s * s * T * T * T * T / 4.0), 1.0, 2e-3);
+  EXPECT_DOUBLE_EQ(b.t, T);
+  // A bias that wanders (Gauss-Markov of sigma s, from zero) drifts, less than one of that
+  // sigma held from the start; standing still adds nothing.
+  StandaloneDrift c;
+  c.start(0.0, 0.0);
+  c.step(T, v, 0.0, s, 3600.0);
+  EXPECT_GT(c.lateral_variance(), 0.01 * b.lateral_variance());
+  EXPECT_LT(c.lateral_variance(), b.lateral_variance());
+  const double before = c.lateral_variance();
+  c.step(T + 100.0, 0.0, arw, s, 3600.0);
+  EXPECT_DOUBLE_EQ(c.lateral_variance(), before);
+}
+
+// A Body-IMU's unmodulated yaw bias makes its drift on its own grow faster than a Wheel-IMU's
+// of the same chip, so its weight falls over the run; two Wheel-IMUs of one chip stay equal.
+TEST(StandaloneDrift, TheBodyImuCountsLessTheLongerItDrivesOnItsOwn) {
+  FusionOptions o;
+  o.weighting = ReferenceWeighting::kStandalone;
+  ReferenceWeights w(o, {1.0, 1.0, 1.0});
+  EXPECT_TRUE(w.from_standalone());
+  ImuNoise q;
+  q.gyro_arw = 0.25 * kDeg / 60.0;
+  q.gyro_bias_std = 10.0 * kDeg / 3600.0;
+  const double bias_var0 = std::pow(3.0 * kDeg / 3600.0, 2);
+  double body_share_early = 0.0;
+  for (int k = 1; k <= 900; ++k) {
+    w.observe_standalone(0, k, 5.0, q, true, 0.0);
+    w.observe_standalone(1, k, 5.0, q, true, 0.0);
+    w.observe_standalone(2, k, 5.0, q, false, bias_var0);
+    if (k == 30) body_share_early = w.weight(2) / (w.weight(0) + w.weight(1) + w.weight(2));
+  }
+  const double body_share = w.weight(2) / (w.weight(0) + w.weight(1) + w.weight(2));
+  EXPECT_DOUBLE_EQ(w.weight(0), w.weight(1));
+  EXPECT_LT(body_share, 0.1);
+  EXPECT_GT(body_share_early, 0.2);
 }

@@ -44,6 +44,7 @@ Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& 
       weights_(opt_.fusion, configured_weights(subs_)) {
   opt_.validate();
   static_.resize(subs_.size());
+  standstill_.configure(opt_.standstill);
 }
 
 Navigator::~Navigator() = default;
@@ -51,6 +52,19 @@ Navigator::~Navigator() = default;
 void Navigator::process(int index, const ImuSample& raw) {
   ++stats_.samples;
   Subsystem& s = subs_[index];
+  // The vehicle's motion over a stretch with no data from any module is unknown: bridged
+  // (extrapolated) up to max_outage, an error beyond it (docs/faults.md, "Outages").
+  if (last_sample_t_ >= static_start_ && raw.t - last_sample_t_ > opt_.faults.max_outage) {
+    char what[256];
+    std::snprintf(what, sizeof what,
+                  "no data from any module between t = %.6f s and t = %.6f s (a gap of %.6g s, longer "
+                  "than faults.max_outage_s = %g s): the vehicle's motion across it is unknown, so the "
+                  "navigation stops here",
+                  last_sample_t_, raw.t, raw.t - last_sample_t_, opt_.faults.max_outage);
+    throw OutageError("'" + subs_.source(index) + "' (module '" + s.module().name + "'): " + what, index,
+                      last_sample_t_, raw.t);
+  }
+  if (raw.t > last_sample_t_) last_sample_t_ = raw.t;
   ImuSample b = s.to_body(raw);
   if (!navigating_) {
     if (raw.t <= static_start_) return;
@@ -67,6 +81,8 @@ void Navigator::process(int index, const ImuSample& raw) {
   // Mechanization, and the covariance time update when due (the filter's).
   s.propagate(b);
   filter_->propagated(index);
+  standstill_.add(index, b, s.ekf().errors());
+  if (s.is_wheel()) faults_->tally_rotation(index, b);
 
   // Updates when every subsystem in use has reached the scheduled time.
   const double t_all = min_time();
@@ -108,7 +124,7 @@ void Navigator::process(int index, const ImuSample& raw) {
 
 void Navigator::start_navigation(double t0) {
   for (int i = 0; i < subs_.size(); ++i) {
-    if (static_[i].count() < 10) {
+    if (static_[i].count() < kMinStaticSamples) {
       char period[96];
       std::snprintf(period, sizeof period, "[%.3f, %.3f] s", static_start_, static_end_);
       throw InputError("'" + subs_.source(i) + "' (module '" + subs_[i].module().name +
@@ -135,9 +151,16 @@ void Navigator::velocity_step() {
   faults_->on_velocity_step(t);
   // Shared information (Section III): the vehicle level from the Body-INS, the wheel speed.
   share_level();
+  if (standstill_.evaluate(vehicle_modules(), subs_.size(), t)) {
+    zero_motion_step();
+    return;
+  }
   SharedInputs& sh = shared_;
   take_level(subs_, level_shared(), false, sh);
   take_wheel_inputs(subs_, in_use_mask(), sh);
+  for (int i = 0; i < subs_.size(); ++i)
+    if (subs_.is_wheel(i) && faults_->in_use(i))
+      faults_->tally_speed(i, sh.wheel[i].measured_speed, opt_.wheel.velocity_update_interval);
   select_speeds(t);
   take_mean_speed(subs_, speeds_, sh);
   // The distributed filter's updates all use the step's shared quantities; the centralized
@@ -157,6 +180,22 @@ void Navigator::velocity_step() {
     noise_.after_velocity(i, meas_, rep, bias_before, t);
     count_velocity_update(i, rep, t);
   }
+}
+
+void Navigator::zero_motion_step() {
+  // Not tested by the fault detector: a standing vehicle's innovations are not evidence
+  // against a module (and its wheel speeds not against the others').
+  const StandstillOptions& o = opt_.standstill;
+  for (int i = 0; i < subs_.size(); ++i) {
+    if (!faults_->in_use(i) || !standstill_.quiet(i)) continue;
+    wheelins::zero_velocity_measurement(subs_, i, o.velocity_std, meas_);
+    filter_->fuse(meas_);
+    wheelins::zero_rate_measurement(subs_, i, standstill_.mean_raw_rate(i), standstill_.window(i), o.rate_std,
+                                    meas_);
+    filter_->fuse(meas_);
+    stats_.zero_motion_updates += 2;
+  }
+  ++stats_.standstill_steps;
 }
 
 void Navigator::select_speeds(double t) {
@@ -242,7 +281,7 @@ void Navigator::position_step() {
   // reference; modules on probation are tied to it without moving it.
   SharedInputs& sh = shared_;
   int n_ref = 0, n_tied = 0;
-  if (weights_.from_covariance()) update_weights();
+  if (weights_.from_covariance() || weights_.from_standalone()) update_weights();
   const bool have_ref = reference_weights(sh.k, n_ref, n_tied);
   faults_->on_position_step(min_time());
   if (have_ref) weights_.record(min_time(), sh.k);
@@ -272,6 +311,24 @@ void Navigator::position_step() {
 
 void Navigator::update_weights() {
   SharedInputs& sh = shared_;
+  if (weights_.from_standalone()) {
+    Mat21 scratch;
+    const double t = min_time();
+    for (int i = 0; i < subs_.size(); ++i) {
+      const Subsystem& s = subs_[i];
+      double bias_var0 = 0.0;
+      if (!s.is_wheel() && !weights_.drift(i).started) {
+        // The body's vertical gyro bias variance as its filter holds it now (after the
+        // alignment): u^T P_bg u with u the vertical in the b-frame.
+        const Vec3 u = s.reference_point_input().C_BtoW.row(2).transpose();
+        bias_var0 = u.dot(filter_->covariance(i, scratch).block<3, 3>(9, 9) * u);
+      }
+      weights_.observe_standalone(i, t, s.reference_velocity_inW().head<2>().norm(), s.process_noise(),
+                                  s.is_wheel(), bias_var0);
+    }
+    subs_.set_weights(weights_.weights());
+    return;
+  }
   take_reference(sh, false);  // every o and its H_mlt at the current state
   Mat21 scratch;
   for (int i = 0; i < subs_.size(); ++i) {

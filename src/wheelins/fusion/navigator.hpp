@@ -31,6 +31,7 @@
 #include "wheelins/fusion/options.hpp"
 #include "wheelins/fusion/output.hpp"
 #include "wheelins/fusion/reference_weights.hpp"
+#include "wheelins/fusion/standstill.hpp"
 #include "wheelins/fusion/subsystems.hpp"
 #include "wheelins/nav/trajectory_record.hpp"
 #include "wheelins/nav/vehicle.hpp"
@@ -90,6 +91,9 @@ class Navigator {
   /// (process() flushes them first).
   void velocity_step();
   void position_step();
+  /// The velocity step of a standing vehicle: every quiet subsystem in use fuses zero velocity
+  /// and zero angular rate (standstill.hpp) instead of its wheel-speed update.
+  void zero_motion_step();
   /// The Body-INS level is shared: sharing on and the Body-INS counted.
   bool level_shared() const;
   /// The vehicle's heading from a counted subsystem that does not steer, other than `except`
@@ -131,6 +135,8 @@ class Navigator {
   std::unique_ptr<FaultHandler> faults_;
   NoiseAdaptation noise_;
   ReferenceWeights weights_;
+  StandstillDetector standstill_;
+  double last_sample_t_ = -1e300;  ///< the newest sample of any module (outage rule)
   std::vector<StaticAccumulator> static_;
   SharedInputs shared_;    ///< scratch of the update steps (no allocation per epoch)
   Measurement meas_;       ///< scratch of the update steps

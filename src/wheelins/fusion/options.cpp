@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <utility>
 
 namespace wheelins {
 
@@ -63,7 +64,9 @@ std::string NavigatorOptions::describe() const {
     << (fusion.weighting == ReferenceWeighting::kCovariance
             ? "inverse variance of each subsystem's o, averaged over " +
                   std::to_string(static_cast<int>(fusion.weight_window)) + " constraint epochs"
-            : std::string(fusion.weights.empty() ? "equal (paper)" : "fixed, as configured"))
+            : fusion.weighting == ReferenceWeighting::kStandalone
+                ? std::string("inverse of each subsystem's drift on its own (federated, no reset)")
+                : std::string(fusion.weights.empty() ? "equal (paper)" : "fixed, as configured"))
     << "\n"
     << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
     << "filter structure:           "
@@ -94,6 +97,13 @@ std::string NavigatorOptions::describe() const {
     << (wheel.estimate_axle_accel_scale_factor ? "estimated" : "held (not told from its bias on one-way turns)")
     << "\n"
     << faults.describe()
+    << "standstill:                 "
+    << (standstill.enabled
+            ? "zero velocity and rate while every IMU is quiet for " + std::to_string(standstill.min_time) +
+                  " s (rates < " + std::to_string(standstill.max_rate / kDeg) + " deg/s, specific force within " +
+                  std::to_string(standstill.max_force_spread) + " m/s^2)"
+            : std::string("off"))
+    << "\n"
     << "output interval:            "
     << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
     << "\n";
@@ -115,6 +125,18 @@ void NoiseAdaptationOptions::validate() const {
   if (!(bias_floor >= 0.0 && std::isfinite(bias_floor))) fail("noise adaptation: bias floor must be >= 0", bias_floor);
 }
 
+void StandstillOptions::validate() const {
+  const std::pair<double, const char*> values[] = {
+      {max_rate, "max_rate_deg_s"}, {max_force_spread, "max_force_spread_m_s2"}, {block, "block_s"},
+      {min_time, "min_time_s"},     {velocity_std, "velocity_std_m_s"},          {rate_std, "rate_std_deg_s"}};
+  for (const auto& [v, key] : values)
+    if (!(v > 0.0 && std::isfinite(v)))
+      throw InputError(std::string("standstill.") + key + ": must be > 0, got " + std::to_string(v));
+  if (min_time < 2.0 * block)
+    throw InputError("standstill.min_time_s: must be at least two blocks (" + std::to_string(2.0 * block) +
+                     " s), got " + std::to_string(min_time));
+}
+
 void NavigatorOptions::validate() const {
   auto fail = [](const char* what, double v) {
     char got[48];
@@ -134,9 +156,10 @@ void NavigatorOptions::validate() const {
     fail("position constraint sigma: must be > 0 m", fusion.position_std);
   if (!(fusion.weight_window >= 1.0 && fusion.weight_window <= 1e6))
     fail("reference weight window: must be in [1, 1e6] constraint epochs", fusion.weight_window);
-  if (fusion.weighting == ReferenceWeighting::kCovariance && !fusion.weights.empty())
-    throw InputError("fusion weights: fixed weights and weights from the covariance exclude each other");
+  if (fusion.weighting != ReferenceWeighting::kFixed && !fusion.weights.empty())
+    throw InputError("fusion weights: fixed weights and weights from the data exclude each other");
   noise.validate();
+  standstill.validate();
 }
 
 }  // namespace wheelins

@@ -35,6 +35,10 @@ enum class YawScaleFactorChoice {
 enum class ReferenceWeighting {
   kFixed,       ///< FusionOptions::weights (empty: equal), the paper
   kCovariance,  ///< each subsystem's own uncertainty of o: inverse variance (reference_weights.hpp)
+  /// Each subsystem's drift on its own, without the constraint: the inverse of the lateral
+  /// variance of its constraint-free heading model (a federated filter's no-reset weights;
+  /// StandaloneDrift in reference_weights.hpp). A Body-IMU's unmodulated yaw bias counts.
+  kStandalone,
 };
 
 struct FusionOptions {
@@ -66,6 +70,18 @@ struct NoiseAdaptationOptions {
   void validate() const;
 };
 
+/// Zero-velocity detection while the vehicle stands (standstill.hpp, docs/faults.md).
+struct StandstillOptions {
+  bool enabled = true;
+  double max_rate = 1.0 * kDeg;     ///< [rad/s] every IMU's compensated rate (block means) below
+  double max_force_spread = 0.3;    ///< [m/s^2] block means of the specific force, max - min per axis
+  double block = 0.05;              ///< [s] the blocks the means are taken over
+  double min_time = 1.0;            ///< [s] quiet this long before the vehicle stands
+  double velocity_std = 0.01;       ///< [m/s] the zero-velocity measurement's sigma
+  double rate_std = 0.05 * kDeg;    ///< [rad/s] the zero-rate sigma (with the gyro noise of the window)
+  void validate() const;
+};
+
 struct NavigatorOptions {
   /// The Wheel-INS and Body-INS settings; their yaw_scale_factors are set from
   /// `yaw_scale_factors` by resolved().
@@ -80,6 +96,8 @@ struct NavigatorOptions {
   FaultOptions faults;
   /// Noise identification from the data (off: the given figures held fixed).
   NoiseAdaptationOptions noise;
+  /// Zero-velocity and zero-rate updates while the vehicle stands.
+  StandstillOptions standstill;
   /// Output interval [s]; 0 = every epoch of the first module.
   double output_interval = 0.0;
   /// Also send each subsystem's own solution to the sink (streams 1..N) of a multi-IMU run.
@@ -108,6 +126,9 @@ struct NavigatorStats {
   std::uint64_t position_updates = 0;
   std::uint64_t position_rejected = 0;
   std::uint64_t records = 0;
+  /// Velocity-update steps at which the vehicle stood (zero velocity and rate fused instead),
+  /// and those updates.
+  std::uint64_t standstill_steps = 0, zero_motion_updates = 0;
   double t_start = 0.0, t_end = 0.0;    ///< navigation interval [s]
   double max_velocity_test_ratio = 0.0;
   double max_position_test_ratio = 0.0;

@@ -11,11 +11,47 @@ double reference_point_variance(const ReferencePointModel& r, const Mat21& P) {
   return (Hh * P * Hh.transpose()).trace();
 }
 
+void StandaloneDrift::start(double t0, double bias_var) {
+  P.setZero();
+  P(2, 2) = std::max(bias_var, 0.0);
+  t = t0;
+  started = true;
+}
+
+void StandaloneDrift::step(double t1, double speed, double arw, double bias_std, double tau) {
+  // Phi = exp(A dt) and Q_d = int Phi Q_c Phi^T to second order in dt (A^3 = 0 but for the
+  // bias decay, which over 1 s of a correlation time of minutes is first order).
+  const double beta = bias_std > 0.0 && tau > 0.0 ? 1.0 / tau : 0.0;
+  const double qb = bias_std > 0.0 && tau > 0.0 ? 2.0 * bias_std * bias_std / tau : 0.0;
+  while (t1 - t > 1e-9) {
+    const double dt = std::min(1.0, t1 - t);
+    Eigen::Matrix3d A;
+    A << 0.0, speed, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -beta;
+    const Eigen::Matrix3d Phi = Eigen::Matrix3d::Identity() + A * dt + A * A * (0.5 * dt * dt);
+    const Eigen::Vector3d qc(0.0, arw * arw, qb);
+    const Eigen::Matrix3d Qc = qc.asDiagonal();
+    const Eigen::Matrix3d AQ = A * Qc;
+    const Eigen::Matrix3d Qd = Qc * dt + (AQ + AQ.transpose()) * (0.5 * dt * dt) +
+                               A * Qc * A.transpose() * (dt * dt * dt / 3.0);
+    P = Phi * P * Phi.transpose() + Qd;
+    t += dt;
+  }
+}
+
 ReferenceWeights::ReferenceWeights(const FusionOptions& options, const std::vector<double>& configured)
     : covariance_(options.weighting == ReferenceWeighting::kCovariance),
+      standalone_(options.weighting == ReferenceWeighting::kStandalone),
       alpha_(1.0 / options.weight_window),
       n_(static_cast<int>(configured.size())) {
-  for (int i = 0; i < n_; ++i) w_[i] = covariance_ ? 1.0 : configured[i];
+  for (int i = 0; i < n_; ++i) w_[i] = covariance_ || standalone_ ? 1.0 : configured[i];
+}
+
+void ReferenceWeights::observe_standalone(int i, double t, double speed, const ImuNoise& q, bool wheel,
+                                          double bias_var0) {
+  StandaloneDrift& d = drift_[i];
+  if (!d.started) d.start(t, wheel ? 0.0 : bias_var0);
+  d.step(t, speed, q.gyro_arw, wheel ? 0.0 : q.gyro_bias_std, q.gyro_bias_tau);
+  w_[i] = 1.0 / std::max(d.lateral_variance(), kMinVariance);
 }
 
 void ReferenceWeights::observe(int i, double variance, bool counted) {
@@ -83,7 +119,9 @@ std::string weights_report(const std::vector<WeightRecord>& history,
   std::string out = std::string("reference weights k_i (eq. 8, ") +
                     (options.weighting == ReferenceWeighting::kCovariance
                          ? "inverse variance of each subsystem's o"
-                         : (options.weights.empty() ? "equal" : "fixed")) +
+                         : options.weighting == ReferenceWeighting::kStandalone
+                               ? "inverse of each subsystem's drift on its own"
+                               : (options.weights.empty() ? "equal" : "fixed")) +
                     "), mean [least, greatest] over " + std::to_string(history.size()) +
                     " constraint epochs:\n";
   char buf[160];

@@ -10,6 +10,14 @@
 // epoch. A module that stops counting (fault handling) keeps no weight; when it counts
 // again its average starts afresh from its own new covariance. docs/filter.md section 14.
 //
+// Those covariances are the constraint's own product: each subsystem takes the fused
+// reference as independent information, so every P shrinks at every constraint epoch and
+// a Body-INS, whose heading the constraint alone makes observable, looks as good as the
+// Wheel-INS it leans on. ReferenceWeighting::kStandalone weighs instead what each
+// subsystem would drift on its own (StandaloneDrift): the weights of a federated filter
+// without reset (Carlson 1990), whose local filters never see the fused solution, so
+// their covariances stay honest. docs/filter.md section 14.1.
+//
 // Every constraint epoch's weights as used in eq. (8) (over the modules that count, 0 for
 // the others) are recorded, with either weighting: the run writes them to weights.csv.
 #pragma once
@@ -33,6 +41,31 @@ struct WeightRecord {
 /// 2x2 block of H_mlt P H_mlt^T (w-frame x, y) [m^2].
 double reference_point_variance(const ReferencePointModel& r, const Mat21& P);
 
+/// A subsystem's lateral drift without the position constraint, for the weights of
+/// ReferenceWeighting::kStandalone: the covariance of [lateral position e (m), heading psi
+/// (rad), vertical gyro bias b (rad/s)] under
+///   e' = v psi,   psi' = b + w_arw,   b' = -b / tau + w_b   (first-order Gauss-Markov),
+/// the heading error that no measurement of a subsystem's own observes (wheel speed and the
+/// non-holonomic constraints see velocity in its own frame, not heading). A Body-IMU's
+/// vertical gyro bias enters as it is (its variance at the start, then its instability); a
+/// Wheel-IMU's gyro turns with the wheel, which modulates the bias of its two axes in the
+/// wheel plane to a zero mean (the paper's rotation modulation), so its heading grows with
+/// the angle random walk alone. The common initial heading error is left out: it moves
+/// every subsystem alike and so no weight.
+struct StandaloneDrift {
+  Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
+  double t = 0.0;
+  bool started = false;
+
+  /// Starts at time t with the vertical bias variance `bias_var` [rad^2/s^2] (0: modulated).
+  void start(double t0, double bias_var);
+  /// Propagates to time t1 at ground speed `speed` [m/s]: angle random walk `arw`
+  /// [rad/sqrt(s)]; the bias a Gauss-Markov process of sigma `bias_std` [rad/s] and
+  /// correlation time `tau` [s] (bias_std 0: no bias, a Wheel-IMU). Steps of at most 1 s.
+  void step(double t1, double speed, double arw, double bias_std, double tau);
+  double lateral_variance() const { return P(0, 0); }
+};
+
 class ReferenceWeights {
  public:
   /// The smallest variance a weight is taken from (1 mm)^2: no subsystem's o is exact.
@@ -42,8 +75,16 @@ class ReferenceWeights {
   ReferenceWeights(const FusionOptions& options, const std::vector<double>& configured);
 
   bool from_covariance() const { return covariance_; }
+  bool from_standalone() const { return standalone_; }
   /// Subsystem i's o variance at this constraint epoch; `counted`: it is in the mean now.
   void observe(int i, double variance, bool counted);
+  /// kStandalone: subsystem i's constraint-free drift at time t (its own noise model `q`;
+  /// `bias_var0` the variance of its vertical gyro bias when it first counts, 0 for a
+  /// Wheel-IMU). Its weight is the inverse of its lateral variance; it keeps growing
+  /// through an outage (the drift of a subsystem left to itself).
+  void observe_standalone(int i, double t, double speed, const ImuNoise& q, bool wheel,
+                          double bias_var0);
+  const StandaloneDrift& drift(int i) const { return drift_[i]; }
   /// Subsystem i's relative weight now (> 0; not normalised).
   double weight(int i) const { return w_[i]; }
   const std::array<double, kMaxModules>& weights() const { return w_; }
@@ -53,11 +94,12 @@ class ReferenceWeights {
   const std::vector<WeightRecord>& history() const { return history_; }
 
  private:
-  bool covariance_;
+  bool covariance_, standalone_;
   double alpha_;  ///< 1 / window
   int n_;
   std::array<double, kMaxModules> w_{}, mean_var_{};
   std::array<bool, kMaxModules> averaging_{};  ///< mean_var_[i] holds an average
+  std::array<StandaloneDrift, kMaxModules> drift_{};
   std::vector<WeightRecord> history_;
 };
 

@@ -73,6 +73,9 @@ Mat3 axle_axis_permutation(int axle_axis);
 /// angles; a Body-IMU's mounting is C_b^v and its samples stay in sensor axes (identity).
 Mat3 wheel_sensor_to_body(const ImuModule& module);
 
+/// The fewest samples of every module in the static period the initial alignment accepts.
+constexpr int kMinStaticSamples = 10;
+
 /// What a navigation run is told before its first sample.
 struct VehicleSetup {
   std::string source;             ///< where it was stated (e.g. a manifest file), for messages
