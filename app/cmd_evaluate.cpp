@@ -22,11 +22,11 @@ struct Options {
   std::string truth, traj, format = "auto", truth_layout = "auto";
   double segment = 100.0;
   double max_gap = 5.0;
-  bool align = false;
+  bool align = false, align_se2 = false, align_origin = false;
   double align_start = 0.0;
   bool force = false;
-  std::string json, series, origin;
-  std::string antenna, truth_columns, truth_frame = "enu", truth_origin;
+  std::string json, series, origin, frame, export_truth;
+  std::string antenna, truth_columns, truth_frame, truth_origin;
   double truth_time_scale = 1.0, truth_time_offset = 0.0;
   bool truth_keep_repeats = false;
 };
@@ -91,13 +91,17 @@ void print_table(std::ostream& os, const eval::EvalResult& r, const TruthData& t
      << "\n";
   os << "truth quality: " << eval::describe_truth_quality(r.truth_quality);
   std::string epochs = std::to_string(r.epochs) + " truth epochs";
-  if (r.skipped_outside || r.skipped_gap || r.skipped_truth_jump) {
+  if (r.skipped_outside || r.skipped_gap || r.skipped_truth_jump || r.skipped_sparse) {
     epochs += " (" + std::to_string(r.skipped_outside) + " outside the trajectory, " +
               std::to_string(r.skipped_gap) + " in its gaps";
+    if (r.skipped_sparse)
+      epochs += ", " + std::to_string(r.skipped_sparse) + " between records sparser than the truth";
     if (r.skipped_truth_jump) epochs += ", " + std::to_string(r.skipped_truth_jump) + " left out at truth jumps";
     epochs += ")";
   }
   row("evaluated", epochs);
+  row("coverage", fmt(r.coverage * 100.0, 1, " %") + " of the truth's " + fmt(r.truth_span, 1, " s") +
+                      (r.comparable ? "" : "  NOT COMPARABLE with a full trajectory's figures"));
   row("duration", fmt(r.duration, 2, " s") + "  (" + fmt(r.t_start, 3) + " .. " +
                       fmt(r.t_end, 3) + ")");
   row("distance", fmt(r.distance, 1, " m"));
@@ -132,12 +136,21 @@ void print_table(std::ostream& os, const eval::EvalResult& r, const TruthData& t
     row("within 3 sigma (horiz.)", "n/a (no north/east std in the trajectory)");
   if (const std::string w = eval::sigma_warning(r); !w.empty())
     std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (const std::string w = eval::coverage_warning(r); !w.empty())
+    std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (r.aligned && r.align_start > 0.0)
     row("alignment", "start aligned over the truth's first " + fmt(r.align_start, 0, " m") + ": rotation " +
                          fmt(r.align_yaw / kDeg, 3, " deg") + ", shift n/e " + fmt(r.align_offset.x(), 3) + " / " +
                          fmt(r.align_offset.y(), 3) + " m (fit residual " + fmt(r.align_residual, 3, " m") + ")");
+  else if (r.align_method == "se3" || r.align_method == "se2")
+    row("alignment", std::string(r.align_method == "se3" ? "SE(3)" : "SE(2), about the vertical,") +
+                         " fit of the whole trajectory onto the truth over " + std::to_string(r.align_points) +
+                         " epochs: rotation roll/pitch/yaw " + fmt(r.align_rpy.x() / kDeg, 3) + " / " +
+                         fmt(r.align_rpy.y() / kDeg, 3) + " / " + fmt(r.align_rpy.z() / kDeg, 3) +
+                         " deg, shift n/e/d " + fmt(r.align_offset.x(), 3) + " / " + fmt(r.align_offset.y(), 3) +
+                         " / " + fmt(r.align_offset.z(), 3) + " m (fit rms " + fmt(r.align_residual, 3, " m") + ")");
   else if (r.aligned)
-    row("alignment", "shift n/e/d " + fmt(r.align_offset.x(), 3) + " / " +
+    row("alignment", "origin (first epoch): shift n/e/d " + fmt(r.align_offset.x(), 3) + " / " +
                          fmt(r.align_offset.y(), 3) + " / " + fmt(r.align_offset.z(), 3) +
                          " m, " +
                          (r.align_rotated ? "rotation " + fmt(r.align_yaw / kDeg, 3, " deg")
@@ -161,6 +174,24 @@ void write_series(const std::string& file, const eval::EvalResult& r, bool force
     out.maybe_flush();
   }
   out.commit();
+}
+
+// The truth as TUM in `frame` (its origin in the header), times shifted by `offset`.
+void export_truth_tum(const std::string& file, const TruthData& truth, const earth::LocalFrame& frame, TumFrame f,
+                      double offset, bool force) {
+  TrajectoryWriterOptions w;
+  w.overwrite = force;
+  w.tum_frame = f;
+  w.origin = frame.origin();
+  const auto out = make_trajectory_writer(TrajectoryFormat::kTum, file, w);
+  for (const TruthRecord& r : truth.records) {
+    TrajectoryRecord t;
+    t.t = r.t + offset;
+    t.p_inN = frame.ned_from_geodetic(r.lla);
+    t.rpy = truth.has_attitude ? r.rpy : Vec3::Zero();
+    out->write(t);
+  }
+  out->commit();
 }
 
 const bool registered = cli::register_command(
@@ -189,10 +220,18 @@ const bool registered = cli::register_command(
                    "Text truth: keep rows repeating the previous fix (default: one fix, at its first row)");
       sub.add_option("--truth-frame", o->truth_frame,
                      "TUM truth: its local frame, enu (body x forward, y left, z up; ROS, evo) or ned "
-                     "(body x forward, y right, z down)")
-          ->capture_default_str();
+                     "(body x forward, y right, z down); default: the file's '# frame:' line, else enu");
       sub.add_option("--truth-origin", o->truth_origin,
-                     "TUM truth: the geodetic origin of its local frame, lat_deg,lon_deg,h_m");
+                     "TUM truth: the geodetic origin of its local frame, lat_deg,lon_deg,h_m (default: the "
+                     "file's '# origin:' line)");
+      sub.add_option("--frame", o->frame,
+                     "TUM files: the trajectory's frame (default: its '# frame:' line, else ned) and the one "
+                     "--export-truth writes in: ned (x north, y east, z down) or enu (x east, y north, z up; "
+                     "ROS, evo)");
+      sub.add_option("--export-truth", o->export_truth,
+                     "Write the truth as a TUM file in the evaluation's local frame (the trajectory's frame "
+                     "and origin when it is a TUM file), times with --truth-time-offset added: "
+                     "`evo_ape tum FILE TRAJ.tum` then compares what this evaluation compares");
       sub.add_option("--antenna", o->antenna,
                      "The truth's antenna in the vehicle frame from the trajectory's point, x,y,z [m] "
                      "(x forward, y right, z down)");
@@ -201,9 +240,15 @@ const bool registered = cli::register_command(
       sub.add_option("--max-gap", o->max_gap,
                      "Largest trajectory time gap interpolated across [s]")
           ->capture_default_str();
-      sub.add_flag("--align", o->align,
-                   "Shift and rotate the trajectory so its first epoch matches the truth "
-                   "(for results in another tool's frame)");
+      sub.add_flag("-a,--align", o->align,
+                   "Rotate and shift the whole trajectory onto the truth, the SE(3) least-squares fit over "
+                   "every evaluated epoch (Umeyama; evo_ape --align)");
+      sub.add_flag("--align-se2", o->align_se2,
+                   "As --align, the rotation about the vertical only (a ground vehicle's heading and "
+                   "position offset)");
+      sub.add_flag("--align-origin,--align_origin", o->align_origin,
+                   "Shift and rotate the trajectory so its first evaluated epoch matches the truth's position "
+                   "and heading (evo_ape --align_origin)");
       sub.add_option("--align-start", o->align_start,
                      "Rotate and shift the trajectory so its first METRES of travel lie on the truth's (a run "
                      "without an initial heading, in a local frame; the heading taken from the reference at the "
@@ -228,19 +273,26 @@ const bool registered = cli::register_command(
         const TrajectoryFormat format = trajectory_format_from_name(o->format);
         if (format == TrajectoryFormat::kKml)
           throw InputError("--format kml: KML is written for viewing only and cannot be evaluated");
-        if (!o->json.empty() && o->json != "-") check_output_target(o->json, o->force);
-        if (!o->series.empty()) check_output_target(o->series, o->force);
+        // Every output checked before anything is read or written (all or nothing); none is an input.
+        std::vector<OutputFile> outputs;
+        if (!o->json.empty() && o->json != "-") outputs.push_back({o->json, "--json"});
+        if (!o->series.empty()) outputs.push_back({o->series, "--series"});
+        if (!o->export_truth.empty()) outputs.push_back({o->export_truth, "--export-truth"});
+        check_output_files(outputs, {{o->truth, "the truth (--truth)"}, {o->traj, "the trajectory (--traj)"}}, o->force);
+        if (int(o->align) + int(o->align_se2) + int(o->align_origin) + int(o->align_start > 0.0) > 1)
+          throw InputError("two alignments asked for: give one of --align, --align-se2, --align-origin and --align-start");
 
         TruthReadOptions read;
         read.time_scale = o->truth_time_scale;
         read.collapse_repeated = !o->truth_keep_repeats;
         if (!o->truth_columns.empty()) set_truth_columns(read, o->truth_columns);
-        read.tum_frame = tum_frame_from_name(o->truth_frame);
+        if (!o->truth_frame.empty()) read.tum_frame = tum_frame_from_name(o->truth_frame);
         if (!o->truth_origin.empty()) read.tum_origin = parse_geodetic("--truth-origin", o->truth_origin);
         eval::EvalOptions opt;
         opt.segment_length = o->segment;
         opt.max_gap = o->max_gap;
-        opt.align = o->align;
+        opt.align_origin = o->align_origin;
+        opt.align_fit = o->align ? eval::AlignFit::kSe3 : o->align_se2 ? eval::AlignFit::kSe2 : eval::AlignFit::kNone;
         opt.align_start = o->align_start;
         opt.truth_time_offset = o->truth_time_offset;
         if (!o->antenna.empty()) {
@@ -249,16 +301,27 @@ const bool registered = cli::register_command(
         }
 
         const TruthLayout found = layout == TruthLayout::kAuto ? detect_truth_layout(o->truth) : layout;
-        if (found != TruthLayout::kTum && (!o->truth_origin.empty() || o->truth_frame != "enu"))
+        if (found != TruthLayout::kTum && (!o->truth_origin.empty() || !o->truth_frame.empty()))
           throw InputError("--truth-origin and --truth-frame are for a TUM truth; '" + o->truth +
                            "' is " + truth_layout_name(found));
         if (found != TruthLayout::kText && (!o->truth_columns.empty() || o->truth_keep_repeats))
           throw InputError("--truth-columns and --truth-keep-repeats are for a text truth; '" + o->truth +
                            "' is " + truth_layout_name(found));
         const TruthData truth = read_truth(o->truth, found, read);
-        const TrajectoryData traj = read_trajectory(o->traj, format);
-        const earth::LocalFrame frame(o->origin.empty() ? truth.records.front().lla
-                                                        : parse_geodetic("--origin", o->origin));
+        const TrajectoryFormat traj_format = format == TrajectoryFormat::kAuto ? detect_trajectory_format(o->traj) : format;
+        TrajectoryReadOptions traj_read;
+        if (!o->frame.empty()) {
+          const TumFrame f = tum_frame_from_name(o->frame);
+          if (traj_format == TrajectoryFormat::kTum) traj_read.tum_frame = f;
+          else if (o->export_truth.empty())
+            throw InputError("--frame " + o->frame + ": it is the frame of a TUM trajectory or of --export-truth; '" +
+                             o->traj + "' is " + trajectory_format_name(traj_format) + " and nothing is exported");
+        }
+        const TrajectoryData traj = read_trajectory(o->traj, traj_format, traj_read);
+        // The local frame: --origin, else the origin a TUM trajectory names, else the first truth record.
+        const earth::LocalFrame frame(!o->origin.empty() ? parse_geodetic("--origin", o->origin)
+                                      : traj.origin      ? *traj.origin
+                                                         : truth.records.front().lla);
         const eval::EvalResult res = eval::evaluate(truth, traj, frame, opt);
 
         // With JSON on stdout the table goes to stderr, so stdout stays parseable.
@@ -272,9 +335,12 @@ const bool registered = cli::register_command(
                       << "clock jump (" << res.skipped_outside << " truth epochs outside the trajectory, "
                       << res.skipped_gap << " in its gaps); the figures are for that part only\n";
         }
-        if (!traj.has_lla && !o->align && o->origin.empty())
-          table << "note: " << o->traj << " has north/east/down only; it was taken to be relative "
-                << "to the first truth record (use --origin or --align otherwise)\n";
+        if (!traj.has_lla && !res.aligned && o->origin.empty() && !traj.origin)
+          table << "note: " << o->traj << " has north/east/down only and names no origin; it was taken to be "
+                << "relative to the first truth record (use --origin or an alignment otherwise)\n";
+        if (traj.format == TrajectoryFormat::kTum)
+          table << "trajectory frame: " << tum_frame_name(traj.tum_frame)
+                << (traj.frame_assumed ? " (assumed: the file has no '# frame:' line; --frame to say)" : "") << "\n";
         const std::string json = eval::to_json(res);
         if (o->json == "-") {
           std::cout << json;
@@ -284,6 +350,17 @@ const bool registered = cli::register_command(
           out.commit();
         }
         if (!o->series.empty()) write_series(o->series, res, o->force);
+        if (!o->export_truth.empty()) {
+          const TumFrame f = traj.format == TrajectoryFormat::kTum ? traj.tum_frame
+                             : o->frame.empty()                     ? TumFrame::kNed
+                                                                    : tum_frame_from_name(o->frame);
+          export_truth_tum(o->export_truth, truth, frame, f, o->truth_time_offset, o->force);
+          std::cerr << "truth written to " << o->export_truth << " (TUM, " << tum_frame_name(f) << ", "
+                    << truth.records.size() << " records"
+                    << (truth.has_attitude ? "" : "; the truth has no attitude: its quaternions are the identity, "
+                                                  "compare positions only")
+                    << ")\n";
+        }
         return 0;
       };
     });

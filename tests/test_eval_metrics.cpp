@@ -199,8 +199,118 @@ TEST(EvalMetrics, SkipsTruthEpochsInTrajectoryGaps) {
   EXPECT_EQ(r.series[2].t, 5.0);
   // Distance still follows the truth through the gap.
   EXPECT_NEAR(r.series[2].distance, 5.0, 1e-6);
+  // Across the gap the records are 3 s apart, sparser than the 1 s truth: with a larger
+  // max_gap the epochs in it are not interpolated either (skipped_sparse); the scored epochs
+  // either side, 4 s apart, are within max_gap: the truth's 6 s count as covered, and
+  // with max_gap 2 s only 2 of them.
   o.max_gap = 5.0;
-  EXPECT_EQ(evaluate(truth, traj, frame, o).epochs, 7u);
+  const EvalResult r5 = evaluate(truth, traj, frame, o);
+  EXPECT_EQ(r5.epochs, 4u);
+  EXPECT_EQ(r5.skipped_sparse, 3u);
+  EXPECT_NEAR(r5.covered, 6.0, 1e-9);
+  EXPECT_TRUE(r5.comparable);
+  EXPECT_NEAR(r.covered, 2.0, 1e-9);
+  EXPECT_FALSE(r.comparable);
+}
+
+// Issue 33, 7: a trajectory missing most of its records, or of two records, scored a small
+// drift rate with no word. Coverage (the time between scored epochs over the truth's span)
+// marks such results not comparable, in the result, its JSON and a warning.
+TEST(EvalMetrics, CoverageMarksPartialTrajectoriesNotComparable) {
+  const earth::LocalFrame frame(kOrigin);
+  auto pos = [](double t) { return Vec3(10.0 * t, 0.01 * t * t, 0); };  // error grows with t
+  auto truth_pos = [](double t) { return Vec3(10.0 * t, 0, 0); };
+  auto zero = [](double) { return 0.0; };
+  const auto truth = make_truth(frame, 0, 600, 1.0, truth_pos, zero);
+  const EvalResult full = evaluate(truth, make_traj(0, 600, 0.1, pos, zero), frame);
+  EXPECT_TRUE(full.comparable);
+  EXPECT_NEAR(full.coverage, 1.0, 1e-9);
+  EXPECT_TRUE(coverage_warning(full).empty());
+  EXPECT_NE(to_json(full).find("\"comparable\": true"), std::string::npos);
+
+  // 87 % of the records gone: the first 13 % kept.
+  const EvalResult part = evaluate(truth, make_traj(0, 78, 0.1, pos, zero), frame);
+  EXPECT_LT(part.drift_rate, full.drift_rate);  // what made the figure misleading
+  EXPECT_FALSE(part.comparable);
+  EXPECT_NEAR(part.coverage, 78.0 / 600.0, 1e-9);
+  EXPECT_NE(coverage_warning(part).find("NOT comparable"), std::string::npos) << coverage_warning(part);
+  EXPECT_NE(to_json(part).find("\"comparable\": false"), std::string::npos);
+  // Every eighth second kept (gaps of 7 s > max_gap 5 s).
+  TrajectoryData holes = make_traj(0, 600, 0.1, pos, zero);
+  std::vector<TrajectoryRecord> kept;
+  for (const auto& r : holes.records)
+    if (std::fmod(r.t + 1e-9, 8.0) < 1.0) kept.push_back(r);
+  holes.records = kept;
+  const EvalResult h = evaluate(truth, holes, frame);
+  EXPECT_FALSE(h.comparable);
+  EXPECT_GT(h.skipped_gap, 400u);
+  // Two records, at the start and the end.
+  TrajectoryData two = make_traj(0, 600, 600, pos, zero);
+  ASSERT_EQ(two.records.size(), 2u);
+  const EvalResult t2 = evaluate(truth, two, frame);
+  EXPECT_FALSE(t2.comparable);
+  EXPECT_EQ(t2.coverage, 0.0);
+}
+
+// Issue 33, 8: records 5 s apart (run --output-interval 5) against a 10 Hz truth were
+// interpolated along straight lines, which in a turn is neither the path nor the heading the
+// filter computed. They are scored where they fall on truth epochs, exactly.
+TEST(EvalMetrics, SparseRecordsAreScoredAtTheirOwnEpochs) {
+  const earth::LocalFrame frame(kOrigin);
+  // A circle of 50 m radius at 10 m/s, the yaw rate changing (a slalom on top).
+  auto heading = [](double t) { return 0.2 * t + 0.3 * std::sin(0.5 * t); };
+  // The path on the 0.1 s grid, integrated at 10 m/s in 10 ms steps along the heading.
+  std::vector<Vec3> path(1, Vec3::Zero());
+  Vec3 p = Vec3::Zero();
+  for (int i = 0; i < 6000; ++i) {
+    const double h = heading((i + 0.5) * 0.01);
+    p += 0.1 * Vec3(std::cos(h), std::sin(h), 0.0);
+    if ((i + 1) % 10 == 0) path.push_back(p);
+  }
+  auto grid = [&](double t) { return path[static_cast<std::size_t>(std::llround(t / 0.1))]; };
+  const auto truth = make_truth(frame, 0, 60, 0.1, grid, heading);
+  const EvalResult sparse = evaluate(truth, make_traj(0, 60, 5.0, grid, heading), frame);
+  EXPECT_EQ(sparse.epochs, 13u);  // t = 0, 5, ..., 60
+  EXPECT_EQ(sparse.skipped_sparse, 600u - 12u);
+  EXPECT_LT(sparse.max_error, 1e-6);
+  EXPECT_LT(sparse.heading_rmse, 1e-9);
+  EXPECT_TRUE(sparse.comparable);  // its epochs span the truth, 5 s apart
+  // Dense records (0.1 s) are interpolated at the truth epochs as before.
+  const EvalResult dense = evaluate(truth, make_traj(0, 60, 0.1, grid, heading), frame);
+  EXPECT_EQ(dense.epochs, 601u);
+  EXPECT_EQ(dense.skipped_sparse, 0u);
+}
+
+// Issue 33, 10: the errors of a lat/lon trajectory were taken as "horizontal" in the frame of
+// evaluate --origin, which far from the data mixes in the height error. They are taken in the
+// truth point's own north/east/down, and the distance in the truth's own frame.
+TEST(EvalMetrics, LatLonFiguresDoNotDependOnTheFrameOrigin) {
+  const earth::LocalFrame here(kOrigin);
+  auto truth_pos = [](double t) { return Vec3(10.0 * t, 2.0 * t, 0.5 * std::sin(t)); };
+  auto zero = [](double) { return 0.0; };
+  const auto truth = make_truth(here, 0, 300, 1.0, truth_pos, zero);
+  TrajectoryData traj;
+  traj.file = "traj.csv";
+  traj.has_lla = true;
+  traj.has_heading = true;
+  for (int k = 0; k <= 3000; ++k) {
+    const double t = 0.1 * k;
+    TrajectoryRecord r;
+    r.t = t;
+    // 0.1 m north, 0.05 m east and 2 m of height error growing with time.
+    r.lla = here.geodetic_from_ned(truth_pos(t) + Vec3(0.1, 0.05, -2.0 * t / 300.0));
+    traj.records.push_back(r);
+  }
+  const EvalResult a = evaluate(truth, traj, here);
+  EXPECT_NEAR(a.final_error, std::hypot(0.1, 0.05), 2e-3);  // (the offsets are in the frame at the start)
+  for (const double km : {100.0, 1000.0}) {
+    const earth::LocalFrame far(here.geodetic_from_ned(Vec3(0.6 * km * 1e3, 0.8 * km * 1e3, 0.0)));
+    const EvalResult b = evaluate(truth, traj, far);
+    EXPECT_NEAR(b.final_error, a.final_error, 1e-6) << km;
+    EXPECT_NEAR(b.max_error, a.max_error, 1e-6) << km;
+    EXPECT_NEAR(b.distance, a.distance, 1e-6) << km;
+    EXPECT_NEAR(b.drift_rate, a.drift_rate, 1e-9) << km;
+  }
 }
 
 TEST(EvalMetrics, SigmaFractionAndNees) {
@@ -254,7 +364,7 @@ TEST(EvalMetrics, AlignmentRemovesInitialOffsetAndHeading) {
   EXPECT_NEAR(raw.heading_rmse / kDeg, 30.0, 1e-9);
 
   EvalOptions o;
-  o.align = true;
+  o.align_origin = true;
   const EvalResult r = evaluate(truth, traj, frame, o);
   EXPECT_TRUE(r.aligned && r.align_rotated);
   EXPECT_NEAR(r.align_yaw / kDeg, 30.0, 1e-9);

@@ -13,7 +13,7 @@ StartAlignedEvaluator::StartAlignedEvaluator(const earth::LocalFrame& frame, con
       collecting_(options.align_start > 0.0) {
   if (!(options.align_start >= 0.0 && options.align_start <= 1e6))
     throw InputError("the start alignment's length must be in [0, 1e6] m, got " + std::to_string(options.align_start));
-  if (collecting_ && options.align)
+  if (collecting_ && options.align_origin)
     throw InputError("two alignments asked for: the first epoch's (align) and the start's (align_start); give one");
   if (collecting_ && !sources.traj_has_heading)
     throw InputError(io_detail::quote(sources.traj_file) + ": aligning the start needs the trajectory's heading, "
@@ -99,6 +99,7 @@ EvalResult StartAlignedEvaluator::finish() {
   EvalResult r = ev_.finish();
   if (alignment_.found) {
     r.aligned = true;
+    r.align_method = "start";
     r.align_rotated = true;
     r.align_yaw = alignment_.yaw;
     r.align_offset = Vec3(alignment_.shift.x(), alignment_.shift.y(), 0.0);

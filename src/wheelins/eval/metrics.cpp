@@ -21,10 +21,17 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTimeSlack = 1e-6;  // [s] end-point tolerance of the time brackets
+constexpr double kCoincide = 1e-3;   // [s] a trajectory record "at" a truth epoch
 
 std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
 
 double lerp(double a, double b, double f) { return a + (b - a) * f; }
+
+std::string fixed(double v, int decimals) {
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+  return buf;
+}
 
 }  // namespace
 
@@ -67,10 +74,12 @@ struct Evaluator::State {
     double yaw_rate = 0.0;   // [rad/s] over the interval ending here
     double lever_fwd = 0.0;  // [m] the antenna's forward offset, levelled (roll and pitch taken off)
   };
-  enum class Match { kWaiting, kEpoch, kOutside, kGap };
+  enum class Match { kWaiting, kEpoch, kOutside, kGap, kSparse };
   struct Slot {  // one truth record on its way
     double t = 0.0, heading = kNaN, s = 0.0;
+    double dt_truth = 0.0;  // to the previous truth record [s] (inf for the first)
     Vec3 p = Vec3::Zero();
+    Mat3 R_local = Mat3::Identity();  // the evaluation frame's axes to the truth point's own NED
     bool bad = false;
     Match match = Match::kWaiting;
     Vec3 traj_p = Vec3::Zero();  // the interpolated trajectory
@@ -107,6 +116,10 @@ struct Evaluator::State {
 
   bool have_truth = false;
   double truth_s = 0.0, first_truth_t = 0.0, last_truth_t = 0.0;
+  // The truth's own local frame (at its first record) for its path length and quality
+  // checks: the figures do not depend on the evaluation frame's origin.
+  earth::LocalFrame truth_frame;
+  double last_epoch_t = -kInf, covered_s = 0.0;  // coverage: time between scored epochs
 
   // Alignment, fixed at the first evaluated epoch.
   bool pivot_set = false;
@@ -122,8 +135,11 @@ struct Evaluator::State {
   // Drift curve (r_k = max{e_h : s <= k l} / (k l)), built as the epochs come.
   double running_max = 0.0;
 
+  Mat3 C_frame_T;  // the evaluation frame's NED axes to ECEF
+
   State(const earth::LocalFrame& f, const Sources& s, const EvalOptions& o, bool keep)
-      : frame(f), src(s), opt(o), keep_series(keep), quality(o.truth_quality) {
+      : frame(f), src(s), opt(o), keep_series(keep), quality(o.truth_quality),
+        C_frame_T(earth::dcm_ecef_to_ned(f.origin().lat, f.origin().lon).transpose()) {
     use_course = !s.truth_has_attitude && s.traj_has_heading;
   }
 
@@ -160,8 +176,9 @@ struct Evaluator::State {
       pivot_set = true;
       s0 = x.s;
       res.t_start = x.t;
-      if (opt.align) {
+      if (opt.align_origin) {
         res.aligned = true;
+        res.align_method = "origin";
         pivot_traj = p;
         pivot_truth = x.p;
         res.align_offset = pivot_truth - pivot_traj;
@@ -174,14 +191,16 @@ struct Evaluator::State {
         }
       }
     }
-    if (opt.align) {
+    if (opt.align_origin) {
       p = R * (p - pivot_traj) + pivot_truth;
       heading += dpsi;
     }
     EpochError e;
     e.t = x.t;
     e.distance = x.s - s0;
-    e.err_ned = p - x.p;
+    // In the truth point's own north/east/down: exact whatever the evaluation frame's origin
+    // (in a frame whose origin is far away, "horizontal" would mix in the height error).
+    e.err_ned = x.R_local * (p - x.p);
     e.err_h = e.err_ned.head<2>().norm();
     e.heading_err = res.has_heading && std::isfinite(ref) ? wrap_pi(heading - ref) : kNaN;
     e.sigma_h = kNaN;
@@ -206,6 +225,8 @@ struct Evaluator::State {
       ++heading_count;
     }
     drift_add(e.distance, e.err_h);
+    if (x.t - last_epoch_t <= opt.max_gap + kTimeSlack) covered_s += x.t - last_epoch_t;
+    last_epoch_t = x.t;
     ++res.epochs;
     last = e;
     if (keep_series) res.series.push_back(e);
@@ -238,8 +259,17 @@ struct Evaluator::State {
           match(x, n_traj == 1 ? b : a, n_traj == 1 ? b : a, 0.0);
         } else {
           const double span = b.t - a.t;
-          if (span > opt.max_gap) x.match = Match::kGap;
-          else match(x, a, b, std::clamp((x.t - a.t) / span, 0.0, 1.0));
+          if (span > opt.max_gap) {
+            x.match = Match::kGap;
+          } else if (span > std::max(kDenseInterval, 1.5 * x.dt_truth)) {
+            // Records sparser than the truth: scored only where one falls on a truth epoch
+            // (a line between records seconds apart is not the trajectory the tool computed).
+            if (x.t - a.t <= kCoincide) match(x, a, a, 0.0);
+            else if (b.t - x.t <= kCoincide) match(x, b, b, 0.0);
+            else x.match = Match::kSparse;
+          } else {
+            match(x, a, b, std::clamp((x.t - a.t) / span, 0.0, 1.0));
+          }
         }
       } else if (!final) {
         return;  // at or after the latest sample: wait for the next one
@@ -275,7 +305,7 @@ struct Evaluator::State {
       --k;
       if (j->breaks != k->breaks) continue;  // a gap or a step between them
       const double dt = j->t - k->t;
-      const Eigen::Vector2d d = (j->p - k->p).head<2>();
+      const Eigen::Vector2d d = (x.R_local * (j->p - k->p)).head<2>();  // in the local north/east
       const double speed = d.norm() / dt;
       if (!(dt > 0.0) || !(speed >= opt.course_min_speed)) continue;
       x.course = std::atan2(d.y(), d.x());
@@ -291,6 +321,7 @@ struct Evaluator::State {
       switch (x.match) {
         case Match::kOutside: ++res.skipped_outside; break;
         case Match::kGap: ++res.skipped_gap; break;
+        case Match::kSparse: ++res.skipped_sparse; break;
         default:
           if (x.bad) ++res.skipped_truth_jump;
           else epoch(x);
@@ -337,6 +368,7 @@ Evaluator::Evaluator(const earth::LocalFrame& frame, const Sources& sources,
   r.traj_format = sources.traj_format;
   r.truth_layout = sources.truth_layout;
   r.segment_length = opt.segment_length;
+  r.max_gap = opt.max_gap;
   r.has_heading = (sources.truth_has_attitude || s_->use_course) && sources.traj_has_heading;
   r.heading_source = !sources.traj_has_heading ? "none" : sources.truth_has_attitude ? "truth" : "course";
   r.has_sigma = sources.traj_has_sigma;
@@ -358,9 +390,12 @@ void Evaluator::add_truth(const TruthRecord& r) {
   State::Slot x;
   x.t = r.t + s.opt.truth_time_offset;
   x.p = s.frame.ned_from_geodetic(r.lla);
+  x.R_local = earth::dcm_ecef_to_ned(r.lla.lat, r.lla.lon) * s.C_frame_T;
+  x.dt_truth = s.have_truth ? x.t - s.last_truth_t : kInf;  // the first: no interval known
   x.heading = s.src.truth_has_attitude ? r.rpy.z() : kNaN;
   const double speed = s.src.truth_has_velocity ? r.v_ned.head<2>().norm() : kNaN;
-  const TruthQualityMonitor::Verdict v = s.quality.add(x.t, x.p, speed);
+  if (!s.have_truth) s.truth_frame = earth::LocalFrame(r.lla);
+  const TruthQualityMonitor::Verdict v = s.quality.add(x.t, s.truth_frame.ned_from_geodetic(r.lla), speed);
   x.bad = v.bad;
   // Path length over the good records (horizontal; a jump is no distance driven).
   if (s.have_truth) s.truth_s += v.step;
@@ -438,6 +473,8 @@ EvalResult Evaluator::finish() {
                      std::to_string(s.first_truth_t) + " .. " + std::to_string(s.last_truth_t) +
                      " s" +
                      (res.skipped_gap ? ", or only inside gaps longer than the maximum gap" : "") +
+                     (res.skipped_sparse ? ", or only between records sparser than the truth, none of them "
+                                           "at a truth epoch" : "") +
                      (res.skipped_truth_jump ? ", or only at jumps of the truth" : "") +
                      "); do both use the same time scale (GPS seconds of week)?");
   res.t_end = s.last.t;
@@ -460,6 +497,13 @@ EvalResult Evaluator::finish() {
     for (double r : res.drift_curve) sum += r;
     res.drift_rate = sum / static_cast<double>(res.drift_curve.size());
   }
+  // Coverage: the time between scored epochs (no further apart than max_gap) over the
+  // truth's span from the trajectory's start (a run navigates from the end of its static
+  // period); below kMinCoverage the figures are not comparable with a full trajectory's.
+  res.truth_span = s.last_truth_t - std::max(s.first_truth_t, s.first_traj_t);
+  res.covered = s.covered_s;
+  res.coverage = res.truth_span > 0.0 ? std::min(1.0, res.covered / res.truth_span) : 1.0;
+  res.comparable = res.coverage >= kMinCoverage;
   res.heading_epochs = s.heading_count;
   if (s.heading_count > 0) {
     res.heading_rmse = std::sqrt(s.sum_h2 / static_cast<double>(s.heading_count));
@@ -478,8 +522,12 @@ EvalResult Evaluator::finish() {
   return res;
 }
 
-EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
-                    const earth::LocalFrame& frame, const EvalOptions& opt) {
+namespace {
+
+// One pass of evaluate(): every record through the (start-aligned) evaluator, each trajectory
+// record first moved by `move` when given.
+EvalResult evaluate_pass(const TruthData& truth, const TrajectoryData& traj, const earth::LocalFrame& frame,
+                         const EvalOptions& opt, const RigidFit* move) {
   Evaluator::Sources src;
   src.truth_file = truth.file.string();
   src.traj_file = traj.file.string();
@@ -499,11 +547,87 @@ EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
   for (const TrajectoryRecord& r : traj.records) {
     while (i < truth.records.size() && truth.records[i].t + opt.truth_time_offset < r.t)
       ev.add_truth(truth.records[i++]);
-    ev.add_trajectory(r);
+    if (!move) {
+      ev.add_trajectory(r);
+      continue;
+    }
+    // p' = R p + t in the evaluation frame; attitude and velocity turned by R, the north/east
+    // sigmas by its yaw (the diagonal of Rz P Rz^T).
+    TrajectoryRecord m = r;
+    const Vec3 p = traj.has_lla ? frame.ned_from_geodetic(r.lla) : r.p_inN;
+    m.p_inN = move->R * p + move->t;
+    m.lla = frame.geodetic_from_ned(m.p_inN);
+    m.v_inN = move->R * r.v_inN;
+    const Vec3 rpy = traj.has_roll_pitch ? r.rpy : Vec3(0.0, 0.0, r.rpy.z());
+    m.rpy = euler_from_dcm(move->R * dcm_from_euler(rpy));
+    if (!traj.has_roll_pitch) m.rpy.head<2>() = r.rpy.head<2>();
+    const Eigen::Matrix2d Rz = rot_z(euler_from_dcm(move->R).z()).topLeftCorner<2, 2>();
+    const Eigen::Matrix2d P = Rz * r.p_std.head<2>().cwiseAbs2().asDiagonal() * Rz.transpose();
+    m.p_std.head<2>() = P.diagonal().cwiseSqrt();
+    ev.add_trajectory(m);
   }
   ev.end_trajectory();
   while (i < truth.records.size()) ev.add_truth(truth.records[i++]);
   return ev.finish();
+}
+
+// The positions compared at the evaluated epochs: the trajectory's (at the antenna, as
+// evaluated) in `traj_p`, the truth's in `truth_p`.
+void evaluated_pairs(const EvalResult& r, const TruthData& truth, const earth::LocalFrame& frame, double offset,
+                     std::vector<Vec3>& traj_p, std::vector<Vec3>& truth_p) {
+  std::size_t i = 0;
+  for (const EpochError& e : r.series) {
+    while (i < truth.records.size() && truth.records[i].t + offset < e.t) ++i;
+    if (i == truth.records.size() || truth.records[i].t + offset != e.t)
+      throw std::logic_error("evaluate: an evaluated epoch without its truth record");
+    const Vec3 p = frame.ned_from_geodetic(truth.records[i].lla);
+    truth_p.push_back(p);
+    traj_p.push_back(p + e.err_ned);
+  }
+}
+
+}  // namespace
+
+EvalResult evaluate(const TruthData& truth, const TrajectoryData& traj,
+                    const earth::LocalFrame& frame, const EvalOptions& opt) {
+  const bool fit = opt.align_fit != AlignFit::kNone;
+  if (fit && (opt.align_origin || opt.align_start > 0.0))
+    throw InputError("two alignments asked for: the whole trajectory's (se3/se2) and the " +
+                     std::string(opt.align_origin ? "origin's" : "start's") + "; give one");
+  EvalOptions first = opt;
+  first.align_fit = AlignFit::kNone;
+  EvalResult res = evaluate_pass(truth, traj, frame, first, nullptr);
+  if (!fit && traj.format != TrajectoryFormat::kTum) return res;
+  std::vector<Vec3> traj_p, truth_p;
+  evaluated_pairs(res, truth, frame, opt.truth_time_offset, traj_p, truth_p);
+  if (traj.format == TrajectoryFormat::kTum) {
+    const MirrorCheck m = check_mirror(traj_p, truth_p);
+    if (m.mirrored) {
+      const char* read_as = tum_frame_name(traj.tum_frame);
+      const char* other = traj.tum_frame == TumFrame::kNed ? "enu" : "ned";
+      throw InputError(quote(traj.file) + ": its track is the mirror image of the truth's (a reflection fits it to " +
+                       fixed(m.reflection_rms, 2) + " m rms, no rotation better than " + fixed(m.rotation_rms, 2) +
+                       " m over " + std::to_string(m.points) + " epochs): a TUM file in ENU (x east, y north: "
+                       "ROS, evo) read as NED, or the reverse. It was read as " + read_as +
+                       (traj.frame_assumed ? " (the file has no frame line and none was given)" : "") +
+                       "; give the frame it is in (--frame " + other + ")");
+    }
+  }
+  if (!fit) return res;
+  const RigidFit move = fit_rigid(traj_p, truth_p, opt.align_fit);
+  if (!move.found)
+    throw InputError(quote(traj.file) + ": aligning the whole trajectory needs at least 3 evaluated epochs, got " +
+                     std::to_string(res.epochs));
+  res = evaluate_pass(truth, traj, frame, first, &move);
+  res.aligned = true;
+  res.align_method = opt.align_fit == AlignFit::kSe3 ? "se3" : "se2";
+  res.align_rotated = true;
+  res.align_rpy = euler_from_dcm(move.R);
+  res.align_yaw = res.align_rpy.z();
+  res.align_offset = move.t;
+  res.align_residual = move.rms;
+  res.align_points = move.points;
+  return res;
 }
 
 namespace {
@@ -562,6 +686,19 @@ class JsonObject {
 
 }  // namespace
 
+std::string coverage_warning(const EvalResult& r) {
+  if (r.comparable) return {};
+  char buf[600];
+  std::snprintf(buf, sizeof buf,
+                "the figures are NOT comparable with a full trajectory's: the trajectory covers %.1f %% of "
+                "the truth's %.1f s from the trajectory's start (%.1f s; %zu truth epochs outside it, %zu in its gaps longer than %.3g s, "
+                "%zu between records sparser than the truth); the drift rate, errors and heading RMSE "
+                "are for the covered part only",
+                r.coverage * 100.0, r.truth_span, r.covered, r.skipped_outside, r.skipped_gap, r.max_gap,
+                r.skipped_sparse);
+  return buf;
+}
+
 std::string sigma_warning(const EvalResult& r) {
   if (!r.has_sigma || !(r.mean_nees > kOverconfidentNees)) return {};
   char buf[200];
@@ -585,6 +722,11 @@ std::string to_json(const EvalResult& r) {
   j.count("skipped_outside", r.skipped_outside);
   j.count("skipped_gap", r.skipped_gap);
   j.count("skipped_truth_jump", r.skipped_truth_jump);
+  j.count("skipped_sparse", r.skipped_sparse);
+  j.num("truth_span_s", r.truth_span);
+  j.num("covered_s", r.covered);
+  j.num("coverage_fraction", r.coverage);
+  j.boolean("comparable", r.comparable);
   j.num("t_start_s", r.t_start);
   j.num("t_end_s", r.t_end);
   j.num("duration_s", r.duration);
@@ -611,12 +753,16 @@ std::string to_json(const EvalResult& r) {
   j.num("within_3sigma_fraction", r.within_3sigma);
   j.num("mean_nees_h", r.mean_nees);
   j.boolean("aligned", r.aligned);
+  j.str("align_method", r.align_method);
   j.boolean("align_rotated", r.align_rotated);
   j.num("align_yaw_deg", r.align_yaw / kDeg);
   j.num("align_start_m", r.align_start);
   j.num("align_residual_m", r.align_residual);
   j.key("align_offset_ned_m");
   json_vec3(o, r.align_offset);
+  j.key("align_rotation_rpy_deg");
+  json_vec3(o, r.align_rpy / kDeg);
+  j.count("align_points", r.align_points);
   j.key("antenna_m");
   json_vec3(o, r.antenna);
   j.num("truth_time_offset_s", r.truth_time_offset);

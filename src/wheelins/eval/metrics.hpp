@@ -11,6 +11,23 @@
 //    values: linear. Truth epochs outside the trajectory's time span are skipped
 //    (no extrapolation), as are epochs whose bracketing trajectory records are more
 //    than `max_gap` seconds apart (an output gap is not evidence of accuracy).
+//  * Rate: the trajectory is interpolated only between records at most
+//    max(kDenseInterval, 1.5 x the truth's record interval) apart. Sparser records (e.g.
+//    `run --output-interval 5` against a 200 Hz truth) are scored only at the truth epochs
+//    within kCoincide (1 ms) of a record, the record's own values against the truth's;
+//    the truth epochs between them are skipped (skipped_sparse): a straight line through
+//    records seconds apart is not the path, nor the heading, the tool computed.
+//  * Coverage: covered = the time between consecutive scored epochs no more than
+//    `max_gap` apart; coverage = covered / the truth's time span from the trajectory's first
+//    record on (a run navigates from the end of its static period; a trajectory that ends
+//    early or has gaps is what is caught). Below kMinCoverage the
+//    result is marked not comparable (comparable = false, coverage_warning()): the figures
+//    describe the covered part only (a trajectory with most records missing, or two
+//    records, scores a small drift rate).
+//  * Frames: positions are compared in the truth point's own north/east/down (the error
+//    vector rotated from the evaluation frame, exact), and the truth's path length, course
+//    and quality checks are taken in the truth's own frames, so that for a lat/lon
+//    trajectory no figure depends on the evaluation frame's origin (evaluate --origin).
 //  * Distance: s(t) = horizontal path length along the truth, accumulated over
 //    consecutive truth records from the first evaluated epoch (horizontal, so the
 //    height noise of the reference does not add distance while standing).
@@ -53,11 +70,19 @@
 //    (skipped_truth_jump); gaps, stalls and jumps are listed in truth_quality. A truth gap
 //    holds no truth epochs, so nothing is scored inside it; the course is not taken across
 //    it and the distance counts the straight line across it (truth_quality.gap_distance).
-//  * Alignment (optional, for results in another tool's frame): the trajectory is
-//    rotated about the vertical through its position at the first evaluated epoch
-//    by dpsi = wrap(heading_truth - heading_traj) there, and shifted so that
-//    position equals the truth's; heading_traj += dpsi. Without headings on both
-//    sides only the shift is applied (reported).
+//  * Alignment of the origin (align_origin; evo's --align_origin, for results in another
+//    tool's frame): the trajectory is rotated about the vertical through its position at the
+//    first evaluated epoch by dpsi = wrap(heading_truth - heading_traj) there, and shifted so
+//    that position equals the truth's; heading_traj += dpsi. Without headings on both sides
+//    only the shift is applied (reported).
+//  * Alignment of the whole trajectory (align_fit; evo's --align, evaluate() only): the
+//    trajectory is evaluated once as it is, the rotation and translation that carry its
+//    positions at the evaluated epochs onto the truth's are fitted (rigid_fit.hpp: SE(3), or
+//    SE(2) = about the vertical only), and it is evaluated again moved by them (attitude and
+//    velocity turned, north/east sigmas turned by the fit's yaw).
+//  * Frame check (evaluate() only, TUM trajectories): a trajectory whose horizontal track is
+//    the mirror image of the truth's (rigid_fit.hpp, check_mirror) is an InputError: an ENU
+//    file read as NED or the reverse, which no rotation undoes.
 #pragma once
 
 #include <cstddef>
@@ -65,6 +90,7 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/eval/rigid_fit.hpp"
 #include "wheelins/eval/truth_quality.hpp"
 #include "wheelins/io/trajectory.hpp"
 #include "wheelins/io/truth.hpp"
@@ -73,10 +99,14 @@ namespace wheelins::eval {
 
 /// The drift-rate segment length's range [m]: the curve has distance / l entries.
 constexpr double kMinSegment = 1.0, kMaxSegment = 1e6;
+/// [s] trajectory records at most this far apart (or 1.5 truth intervals) are interpolated.
+constexpr double kDenseInterval = 0.2;
+/// The least coverage (covered time / the truth's span) of a comparable result.
+constexpr double kMinCoverage = 0.9;
 
 struct EvalOptions {
   double segment_length = 100.0;  ///< l [m] of the drift rate
-  bool align = false;             ///< shift + rotate the trajectory onto the truth at the start
+  bool align_origin = false;      ///< shift + rotate the trajectory onto the truth at the first epoch
   /// > 0: the trajectory's start is aligned onto the truth's over this much of the truth's
   /// travel [m] (a run without an initial heading; eval/alignment.hpp, StartAlignedEvaluator).
   double align_start = 0.0;
@@ -88,6 +118,8 @@ struct EvalOptions {
   double course_baseline = 1.0;    ///< B [s] of the course heading, in (0, 60]
   double course_min_speed = 1.0;   ///< [m/s] slowest truth motion whose course is used
   TruthQualityOptions truth_quality{};  ///< the thresholds of the truth quality checks
+  /// Fit the whole trajectory onto the truth (evaluate() only; see the header).
+  AlignFit align_fit = AlignFit::kNone;
 };
 
 /// The comparison at one evaluated truth epoch.
@@ -109,6 +141,12 @@ struct EvalResult {
   std::size_t skipped_outside = 0;    ///< truth epochs outside the trajectory's time span
   std::size_t skipped_gap = 0;        ///< truth epochs inside a trajectory gap > max_gap
   std::size_t skipped_truth_jump = 0; ///< truth epochs left out: a jumped fix or its repeat
+  std::size_t skipped_sparse = 0;     ///< truth epochs between records sparser than the truth
+  double max_gap = 5.0;               ///< EvalOptions::max_gap [s]
+  double truth_span = 0.0;            ///< last truth time - max(first truth, first trajectory time) [s]
+  double covered = 0.0;               ///< time between scored epochs <= max_gap apart [s]
+  double coverage = 1.0;              ///< covered / truth_span
+  bool comparable = true;             ///< coverage >= kMinCoverage
   double t_start = 0.0, t_end = 0.0, duration = 0.0;  ///< evaluated span [s]
   double distance = 0.0;              ///< s_total [m]
   double segment_length = 100.0;
@@ -130,11 +168,15 @@ struct EvalResult {
   double within_3sigma = 0.0;         ///< fraction in [0, 1]; NaN without sigma
   double mean_nees = 0.0;             ///< NaN without sigma
   bool aligned = false;
+  /// "origin", "start", "se3", "se2" (the alignment applied) or "" (none).
+  std::string align_method;
   bool align_rotated = false;         ///< heading part applied
   double align_yaw = 0.0;             ///< dpsi [rad]
   Vec3 align_offset = Vec3::Zero();   ///< truth - trajectory position at the pivot [m]; start alignment: its shift
   double align_start = 0.0;           ///< [m] of truth travel the start alignment used (0: none)
-  double align_residual = 0.0;        ///< [m] rms of the start alignment's fit
+  double align_residual = 0.0;        ///< [m] rms of the start alignment's or the se3/se2 fit
+  Vec3 align_rpy = Vec3::Zero();      ///< se3/se2: the fitted rotation as roll, pitch, yaw [rad]
+  std::size_t align_points = 0;       ///< se3/se2: the epochs fitted
   std::vector<EpochError> series;     ///< one entry per evaluated epoch
 };
 
@@ -146,6 +188,10 @@ constexpr double kOverconfidentNees = 10.0;
 /// "the trajectory's 1-sigma figures understate its error: ..." when the mean horizontal NEES
 /// is above kOverconfidentNees; empty otherwise (or without sigmas).
 std::string sigma_warning(const EvalResult& result);
+
+/// "the figures are NOT comparable ..." when the result is not comparable (coverage below
+/// kMinCoverage); empty otherwise.
+std::string coverage_warning(const EvalResult& result);
 
 /// r_k = max{err[i] : s[i] <= k l} / (k l) for k = 1..floor(s.back() / l), with s
 /// non-decreasing distances from 0. Empty when s.back() < l.

@@ -148,15 +148,34 @@ class CsvWriter final : public TrajectoryWriter {
 
 class TumWriter final : public TrajectoryWriter {
  public:
-  TumWriter(const std::filesystem::path& file, bool overwrite) : out_(file, overwrite) {
-    out_.write("# t x(north) y(east) z(down) qx qy qz qw  (q: vehicle attitude C_v^n)\n");
+  TumWriter(const std::filesystem::path& file, const TrajectoryWriterOptions& opt)
+      : out_(file, opt.overwrite), frame_(opt.tum_frame) {
+    // The three comment lines read_tum_header() understands (evo and other TUM readers skip them).
+    out_.write(frame_ == TumFrame::kNed
+                   ? "# frame: ned (x north, y east, z down; q: body x forward, y right, z down -> NED)\n"
+                   : "# frame: enu (x east, y north, z up; q: body x forward, y left, z up -> ENU)\n");
+    if (opt.origin) {
+      std::string o = "# origin: ";
+      append_double(o, opt.origin->lat / kDeg, 15);
+      o += ' ';
+      append_double(o, opt.origin->lon / kDeg, 15);
+      o += ' ';
+      append_double(o, opt.origin->h, 15);
+      out_.write(o + "  (lat_deg lon_deg h_m of the local frame)\n");
+    }
+    out_.write("# t x y z qx qy qz qw\n");
   }
   void write(const TrajectoryRecord& rec) override {
     order_.check(out_.file(), n_, rec.t);
-    const Quat q = quat_from_euler(rec.rpy);
+    Vec3 xyz = rec.p_inN;
+    Quat q = quat_from_euler(rec.rpy);  // NED: as written before the frame line existed, to the bit
+    if (frame_ == TumFrame::kEnu) {
+      Mat3 C;
+      tum_pose_from_ned(frame_, rec.p_inN, dcm_from_euler(rec.rpy), xyz, C);
+      q = Quat(C);
+    }
     std::string& b = out_.buffer();
-    const double vals[8] = {rec.t,   rec.p_inN.x(), rec.p_inN.y(), rec.p_inN.z(),
-                            q.x(),   q.y(),         q.z(),         q.w()};
+    const double vals[8] = {rec.t, xyz.x(), xyz.y(), xyz.z(), q.x(), q.y(), q.z(), q.w()};
     for (int i = 0; i < 8; ++i) {
       if (i) b += ' ';
       append_double(b, vals[i]);
@@ -170,6 +189,7 @@ class TumWriter final : public TrajectoryWriter {
 
  private:
   AtomicTextFile out_;
+  TumFrame frame_;
   TimeOrder order_;
   std::uint64_t n_ = 0;
 };
@@ -410,21 +430,30 @@ void read_numeric_rows(const std::filesystem::path& file, std::size_t ncols, con
   }
 }
 
-TrajectoryData read_tum(const std::filesystem::path& file) {
+TrajectoryData read_tum(const std::filesystem::path& file, const TrajectoryReadOptions& opt) {
   TrajectoryData out;
   out.file = file;
   out.format = TrajectoryFormat::kTum;
   out.has_ned = out.has_roll_pitch = out.has_heading = true;
+  const TumHeader header = read_tum_header(file);
+  if (header.frame && opt.tum_frame && *header.frame != *opt.tum_frame)
+    throw InputError(at_line(file, header.frame_line) + "the file says its frame is " +
+                     tum_frame_name(*header.frame) + ", but " + tum_frame_name(*opt.tum_frame) +
+                     " was given; leave the frame out or give " + tum_frame_name(*header.frame));
+  out.tum_frame = opt.tum_frame ? *opt.tum_frame : header.frame ? *header.frame : TumFrame::kNed;
+  out.frame_assumed = !opt.tum_frame && !header.frame;
+  out.origin = header.origin;
   read_numeric_rows(file, 8, "TUM: t x y z qx qy qz qw", [&](std::size_t lineno, const double* v) {
     TrajectoryRecord rec;
     rec.t = v[0];
-    rec.p_inN = Vec3(v[1], v[2], v[3]);
     Quat q(v[7], v[4], v[5], v[6]);
     const double n = q.norm();
     if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-3)
       throw InputError(at_line(file, lineno) + "quaternion norm " + num(n) +
                        " is not 1 (expected qx qy qz qw of a unit quaternion)");
-    rec.rpy = euler_from_dcm(q.normalized().toRotationMatrix());
+    Mat3 C_vn;
+    tum_pose_to_ned(out.tum_frame, Vec3(v[1], v[2], v[3]), q.normalized().toRotationMatrix(), rec.p_inN, C_vn);
+    rec.rpy = euler_from_dcm(C_vn);
     check_record(file, lineno, rec, out.records.empty() ? nullptr : &out.records.back(), false,
                  true);
     out.records.push_back(rec);
@@ -465,6 +494,79 @@ std::string lower_ext(const std::filesystem::path& file) {
 
 }  // namespace
 
+TumFrame tum_frame_from_name(const std::string& name) {
+  if (name == "enu" || name == "ENU") return TumFrame::kEnu;
+  if (name == "ned" || name == "NED") return TumFrame::kNed;
+  throw InputError("unknown TUM frame '" + name + "' (expected enu or ned)");
+}
+
+const char* tum_frame_name(TumFrame frame) { return frame == TumFrame::kNed ? "ned" : "enu"; }
+
+namespace {
+// ENU -> NED swaps x and y and turns z (its own inverse); body forward/right/down vectors
+// are forward/left/up ones with y and z turned (also its own inverse).
+Mat3 enu_ned_swap() {
+  Mat3 m;
+  m << 0, 1, 0, 1, 0, 0, 0, 0, -1;
+  return m;
+}
+const Mat3 kFrdFlu = Vec3(1.0, -1.0, -1.0).asDiagonal();
+}  // namespace
+
+void tum_pose_to_ned(TumFrame frame, const Vec3& xyz, const Mat3& C, Vec3& p_ned, Mat3& C_vn) {
+  if (frame == TumFrame::kNed) {
+    p_ned = xyz;
+    C_vn = C;
+    return;
+  }
+  const Mat3 S = enu_ned_swap();
+  p_ned = S * xyz;
+  C_vn = S * C * kFrdFlu;
+}
+
+void tum_pose_from_ned(TumFrame frame, const Vec3& p_ned, const Mat3& C_vn, Vec3& xyz, Mat3& C) {
+  // Both maps are their own inverses, so going back is the same product.
+  tum_pose_to_ned(frame, p_ned, C_vn, xyz, C);
+}
+
+TumHeader read_tum_header(const std::filesystem::path& file) {
+  TumHeader h;
+  std::ifstream in = open_text(file);
+  std::string line;
+  std::size_t lineno = 0;
+  while (io_detail::bounded_getline(in, line, io_detail::kMaxTextLine, quote(file))) {
+    ++lineno;
+    std::string_view l = trim(line);
+    if (l.empty()) continue;
+    if (l.front() != '#') break;  // the first record: the header is over
+    l = trim(l.substr(1));
+    const auto key = [&](std::string_view k) {
+      if (l.substr(0, k.size()) != k) return false;
+      l = trim(l.substr(k.size()));
+      return true;
+    };
+    if (lineno == 1 && l.substr(0, 20) == "t x(north) y(east) z") {
+      h.frame = TumFrame::kNed;
+      h.frame_line = lineno;
+    } else if (key("frame:")) {
+      const std::string_view name = l.substr(0, l.find_first_of(" \t("));
+      if (name != "ned" && name != "enu")
+        throw InputError(at_line(file, lineno) + "frame '" + std::string(name) + "': expected ned or enu");
+      h.frame = name == "ned" ? TumFrame::kNed : TumFrame::kEnu;
+      h.frame_line = lineno;
+    } else if (key("origin:")) {
+      std::vector<std::string_view> f;
+      split(l.substr(0, l.find('(')), ' ', f);
+      double v[3];
+      if (f.size() != 3 || !parse_double(f[0], v[0]) || !parse_double(f[1], v[1]) || !parse_double(f[2], v[2]) ||
+          !(std::abs(v[0]) <= 90.0) || !(std::abs(v[1]) <= 180.0) || !std::isfinite(v[2]))
+        throw InputError(at_line(file, lineno) + "origin: expected LAT_DEG LON_DEG H_M within range");
+      h.origin = earth::Geodetic{v[0] * kDeg, v[1] * kDeg, v[2]};
+    }
+  }
+  return h;
+}
+
 std::vector<std::string> trajectory_csv_header() {
   std::vector<std::string> names;
   for (const auto& c : csv_columns()) names.emplace_back(c.name);
@@ -501,7 +603,7 @@ std::unique_ptr<TrajectoryWriter> make_trajectory_writer(TrajectoryFormat format
                                                          const TrajectoryWriterOptions& options) {
   switch (format) {
     case TrajectoryFormat::kCsv: return std::make_unique<CsvWriter>(file, options.overwrite);
-    case TrajectoryFormat::kTum: return std::make_unique<TumWriter>(file, options.overwrite);
+    case TrajectoryFormat::kTum: return std::make_unique<TumWriter>(file, options);
     case TrajectoryFormat::kKml: return std::make_unique<KmlWriter>(file, options);
     default:
       throw InputError(quote(file) + ": cannot write trajectory format '" +
@@ -537,11 +639,15 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& file) {
   throw InputError(quote(file) + ": empty trajectory file");
 }
 
-TrajectoryData read_trajectory(const std::filesystem::path& file, TrajectoryFormat format) {
+TrajectoryData read_trajectory(const std::filesystem::path& file, TrajectoryFormat format,
+                               const TrajectoryReadOptions& options) {
   if (format == TrajectoryFormat::kAuto) format = detect_trajectory_format(file);
+  if (options.tum_frame && format != TrajectoryFormat::kTum)
+    throw InputError(quote(file) + ": a frame (" + tum_frame_name(*options.tum_frame) + ") is for a TUM trajectory; this is " +
+                     trajectory_format_name(format) + " (its positions are lat/lon/h or its own format's)");
   switch (format) {
     case TrajectoryFormat::kCsv: return read_csv(file);
-    case TrajectoryFormat::kTum: return read_tum(file);
+    case TrajectoryFormat::kTum: return read_tum(file, options);
     case TrajectoryFormat::kWheelInsTraj: return read_wheelins_traj(file);
     default:
       throw InputError(quote(file) + ": cannot read trajectory format '" +

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,9 +31,18 @@ namespace wheelins {
 //       error columns with 9 significant digits. The reader finds columns by
 //       header name (order free, unknown columns ignored); it needs t_s and either
 //       lat_deg/lon_deg/h_m or north_m/east_m/down_m.
-// kTum  (written and read): "t x y z qx qy qz qw" per line, x = north, y = east,
-//       z = down [m] in the local frame, q = the vehicle attitude C_v^n (Hamilton,
-//       rotating v-frame vectors into NED); '#' lines are comments.
+// kTum  (written and read): "t x y z qx qy qz qw" per line [m] in a local frame about a
+//       geodetic origin, in one of two conventions (TumFrame):
+//         ned: x north, y east, z down; q (Hamilton) rotates body vectors (x forward,
+//              y right, z down) into NED: the vehicle attitude C_v^n. wheelins' default.
+//         enu: x east, y north, z up; q rotates body vectors (x forward, y left, z up)
+//              into ENU: ROS (REP 103) and evo.
+//       '#' lines are comments. The writer starts with three of them, which the reader
+//       understands: "# frame: ned|enu ...", "# origin: LAT_DEG LON_DEG H_M" (the local
+//       frame's origin) and the column names. A file without a frame line is read in the
+//       frame asked for, NED when none is asked for (and says so: frame_assumed); a frame
+//       line that contradicts the one asked for is an error. Files written before the frame
+//       line existed start "# t x(north) y(east) z(down)" and are read as NED.
 // kKml  (written only): one LineString of lon,lat,h, decimated to at most one
 //       point per `kml_min_interval` seconds and at most `kml_max_points` points.
 // kWheelInsTraj (read only): the public Wheel-INS result file `traj.txt`
@@ -48,6 +58,33 @@ namespace wheelins {
 // ---------------------------------------------------------------------------
 
 enum class TrajectoryFormat { kAuto, kCsv, kTum, kKml, kWheelInsTraj };
+
+/// The convention of a TUM file (trajectory or truth): its axes and the body axes of its
+/// quaternion (see kTum above).
+enum class TumFrame {
+  kEnu,  ///< x east, y north, z up; body x forward, y left, z up (ROS, evo)
+  kNed,  ///< x north, y east, z down; body x forward, y right, z down (wheelins' default)
+};
+
+/// "enu" / "ned" <-> TumFrame (InputError for other names).
+TumFrame tum_frame_from_name(const std::string& name);
+const char* tum_frame_name(TumFrame frame);
+
+/// A TUM pose in `frame` (position xyz, rotation C of its quaternion) as the NED position and
+/// the vehicle attitude C_v^n (body forward/right/down into NED), and back.
+void tum_pose_to_ned(TumFrame frame, const Vec3& xyz, const Mat3& C, Vec3& p_ned, Mat3& C_vn);
+void tum_pose_from_ned(TumFrame frame, const Vec3& p_ned, const Mat3& C_vn, Vec3& xyz, Mat3& C);
+
+/// What the comment lines at the top of a TUM file (before its first record) say: the
+/// "# frame: ned|enu" and "# origin: LAT_DEG LON_DEG H_M" lines the writer puts there (a
+/// first line "# t x(north) y(east) z(down) ..." of an older wheelins file counts as ned).
+/// A frame or origin line that cannot be read is an InputError naming the line.
+struct TumHeader {
+  std::optional<TumFrame> frame{};
+  std::size_t frame_line = 0;  ///< 1-based
+  std::optional<earth::Geodetic> origin{};
+};
+TumHeader read_tum_header(const std::filesystem::path& file);
 
 /// "auto", "csv", "tum", "kml", "wheelins-traj" <-> TrajectoryFormat.
 TrajectoryFormat trajectory_format_from_name(const std::string& name);
@@ -69,6 +106,9 @@ struct TrajectoryWriterOptions {
   double kml_min_interval = 0.5;          ///< [s] between KML points
   std::size_t kml_max_points = 20000;     ///< hard cap on KML points (>= 2)
   std::string kml_name = "wheelins";      ///< KML document/placemark name
+  TumFrame tum_frame = TumFrame::kNed;    ///< the TUM file's convention
+  /// The origin of the records' p_inN, written into the TUM file's header (none: not written).
+  std::optional<earth::Geodetic> origin{};
 };
 
 /// A writer for `format` (kCsv, kTum or kKml; others throw InputError).
@@ -93,7 +133,18 @@ struct TrajectoryData {
   bool has_roll_pitch = false;
   bool has_heading = false;   ///< rpy.z() is the vehicle heading
   bool has_pos_std = false;   ///< p_std is valid
+  /// TUM: the frame the file was read in (p_inN and rpy are converted to NED / C_v^n), and
+  /// whether it was assumed (no frame line in the file and none asked for).
+  TumFrame tum_frame = TumFrame::kNed;
+  bool frame_assumed = false;
+  /// TUM: the origin of p_inN from the file's "# origin:" line.
+  std::optional<earth::Geodetic> origin{};
   std::vector<TrajectoryRecord> records;
+};
+
+struct TrajectoryReadOptions {
+  /// TUM: the file's frame. Unset: the file's frame line, else NED (frame_assumed).
+  std::optional<TumFrame> tum_frame{};
 };
 
 /// Guesses the format from the extension and the first non-comment line:
@@ -105,6 +156,7 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& file);
 /// the expected number of columns) and throws InputError naming the file and the
 /// line (1-based) of the first problem.
 TrajectoryData read_trajectory(const std::filesystem::path& file,
-                               TrajectoryFormat format = TrajectoryFormat::kAuto);
+                               TrajectoryFormat format = TrajectoryFormat::kAuto,
+                               const TrajectoryReadOptions& options = {});
 
 }  // namespace wheelins

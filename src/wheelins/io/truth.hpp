@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/io/trajectory.hpp"  // TumFrame
 #include "wheelins/nav/earth.hpp"
 
 namespace wheelins {
@@ -58,12 +59,6 @@ struct TruthRecord {
 };
 
 enum class TruthLayout { kAuto, kGins11, kPos5, kText, kTum };
-
-/// The local frame of a TUM truth file: its axes and the body axes of its quaternion.
-enum class TumFrame {
-  kEnu,  ///< x east, y north, z up; body x forward, y left, z up (ROS, evo)
-  kNed,  ///< x north, y east, z down; body x forward, y right, z down (wheelins' own TUM)
-};
 
 /// One column of a text truth file: a header name (matched without regard to case) or a
 /// 0-based index. Neither given: the column is found by its header name (truth_text.hpp).
@@ -83,8 +78,10 @@ struct TruthReadOptions {
   char delimiter = 0;             ///< 0: the first line decides (',', ';', tab, else blanks)
   bool collapse_repeated = true;  ///< consecutive rows with identical lat/lon/h are one fix
   // kTum
-  TumFrame tum_frame = TumFrame::kEnu;
-  std::optional<earth::Geodetic> tum_origin{};  ///< the local frame's origin; required for kTum
+  /// Unset: the file's "# frame:" line (trajectory.hpp), else ENU.
+  std::optional<TumFrame> tum_frame{};
+  /// The local frame's origin; for kTum, given or from the file's "# origin:" line.
+  std::optional<earth::Geodetic> tum_origin{};
 };
 
 /// A whole truth file in memory (a 1 h, 200 Hz file is ~720k records, ~60 MB).

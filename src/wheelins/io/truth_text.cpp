@@ -86,13 +86,6 @@ bool matches_role(const std::string& n, int role) {
   }
 }
 
-std::string strip_bom(std::string line) {
-  if (line.size() >= 3 && static_cast<unsigned char>(line[0]) == 0xEF &&
-      static_cast<unsigned char>(line[1]) == 0xBB && static_cast<unsigned char>(line[2]) == 0xBF)
-    line.erase(0, 3);
-  return line;
-}
-
 // The first line of `file` that is not blank or a comment; false when there is none.
 bool first_data_line(const std::filesystem::path& file, std::string& out, std::uint64_t& line_no) {
   std::ifstream in(file, std::ios::binary);
@@ -101,7 +94,6 @@ bool first_data_line(const std::filesystem::path& file, std::string& out, std::u
   line_no = 0;
   while (io_detail::bounded_getline(in, line, io_detail::kMaxTextLine, quote(file))) {
     ++line_no;
-    if (line_no == 1) line = strip_bom(line);
     if (is_comment_or_blank(line)) continue;
     out = line;
     return true;
@@ -173,14 +165,6 @@ void set_truth_columns(TruthReadOptions& options, const std::string& spec) {
   }
 }
 
-TumFrame tum_frame_from_name(const std::string& name) {
-  if (name == "enu" || name == "ENU") return TumFrame::kEnu;
-  if (name == "ned" || name == "NED") return TumFrame::kNed;
-  throw InputError("unknown TUM frame '" + name + "' (expected enu or ned)");
-}
-
-const char* tum_frame_name(TumFrame frame) { return frame == TumFrame::kNed ? "ned" : "enu"; }
-
 // ------------------------------------------------------------------ the reader
 
 TextTruthReader::TextTruthReader(const std::filesystem::path& file, TruthLayout layout,
@@ -197,6 +181,15 @@ TextTruthReader::TextTruthReader(const std::filesystem::path& file, TruthLayout 
   in_.open(file, std::ios::binary);
   if (!in_) throw InputError(quote(file) + ": cannot open");
   if (layout == TruthLayout::kTum) {
+    // The frame and origin lines a wheelins TUM file starts with stand in for options not given;
+    // a frame line contradicting the one given is an error.
+    const TumHeader h = read_tum_header(file);
+    if (h.frame && opt_.tum_frame && *h.frame != *opt_.tum_frame)
+      throw InputError(quote(file) + ": line " + std::to_string(h.frame_line) + ": the file says its frame is " +
+                       tum_frame_name(*h.frame) + ", but " + tum_frame_name(*opt_.tum_frame) +
+                       " was given; leave the frame out or give " + tum_frame_name(*h.frame));
+    if (!opt_.tum_frame) opt_.tum_frame = h.frame ? *h.frame : TumFrame::kEnu;
+    if (!opt_.tum_origin) opt_.tum_origin = h.origin;
     if (!opt_.tum_origin)
       throw InputError(quote(file) + ": a TUM truth is in a local frame: give the geodetic origin "
                        "of that frame (lat_deg,lon_deg,h_m) and its axes (enu or ned)");
@@ -221,7 +214,6 @@ bool TextTruthReader::next_line(std::string& line) {
   }
   while (io_detail::bounded_getline(in_, line, io_detail::kMaxTextLine, quote(file_))) {
     ++line_no_;
-    if (line_no_ == 1) line = strip_bom(line);
     if (!is_comment_or_blank(line)) return true;
   }
   return false;
@@ -309,7 +301,7 @@ std::string TextTruthReader::describe() const {
   if (opt_.time_offset != 0.0) time_map += (opt_.time_offset > 0 ? " + " : " - ") + num(std::abs(opt_.time_offset)) + " s";
   if (layout_ == TruthLayout::kTum) {
     const earth::Geodetic& o = *opt_.tum_origin;
-    return std::string("TUM in ") + (opt_.tum_frame == TumFrame::kNed ? "NED (body FRD)" : "ENU (body FLU)") +
+    return std::string("TUM in ") + (*opt_.tum_frame == TumFrame::kNed ? "NED (body FRD)" : "ENU (body FLU)") +
            " about lat " + num(o.lat / kDeg) + " deg, lon " + num(o.lon / kDeg) + " deg, h " + num(o.h) +
            " m; time" + (time_map.empty() ? " as written" : time_map);
   }
@@ -397,20 +389,9 @@ bool TextTruthReader::next_tum(TruthRecord& out) {
   const double n = q.norm();
   if (std::abs(n - 1.0) > 1e-3)
     throw InputError(at + "quaternion norm " + num(n) + " is not 1 (expected qx qy qz qw of a unit quaternion)");
-  const Mat3 C = q.normalized().toRotationMatrix();
   Vec3 p_ned;
   Mat3 C_VtoN;
-  if (opt_.tum_frame == TumFrame::kNed) {
-    p_ned = Vec3(v[1], v[2], v[3]);
-    C_VtoN = C;
-  } else {
-    // ENU -> NED swaps x and y and turns z; FRD body vectors are FLU ones with y, z turned.
-    Mat3 enu_to_ned;
-    enu_to_ned << 0, 1, 0, 1, 0, 0, 0, 0, -1;
-    const Mat3 frd_to_flu = Vec3(1.0, -1.0, -1.0).asDiagonal();
-    p_ned = enu_to_ned * Vec3(v[1], v[2], v[3]);
-    C_VtoN = enu_to_ned * C * frd_to_flu;
-  }
+  tum_pose_to_ned(*opt_.tum_frame, Vec3(v[1], v[2], v[3]), q.normalized().toRotationMatrix(), p_ned, C_VtoN);
   const double t = opt_.time_scale * v[0] + opt_.time_offset;
   if (records_ > 0 && !(t > prev_t_))
     throw InputError(at + "time " + num(t) + " s does not increase (previous record: " + num(prev_t_) + " s)");

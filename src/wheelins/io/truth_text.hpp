@@ -61,9 +61,6 @@ TruthLayout detect_text_truth_layout(const std::filesystem::path& file);
 /// digits); sets the four columns of `options`. InputError for another count or an empty one.
 void set_truth_columns(TruthReadOptions& options, const std::string& spec);
 
-/// "enu" / "ned" <-> TumFrame (InputError for other names).
-TumFrame tum_frame_from_name(const std::string& name);
-const char* tum_frame_name(TumFrame frame);
 
 /// The streaming reader of one kText or kTum file (the rules above). The constructor reads
 /// the header (kText) and checks the options; next() validates each record as it goes.
