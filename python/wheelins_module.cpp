@@ -8,10 +8,17 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <thread>
 
 #include "wheelins/eval/metrics.hpp"
 #include "wheelins/eval/run_evaluation.hpp"
@@ -23,7 +30,9 @@
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
+#include "wheelins/run/noise_report.hpp"
 #include "wheelins/sim/simulator.hpp"
+#include "wheelins/util/interrupt.hpp"
 
 namespace py = pybind11;
 using namespace wheelins;
@@ -59,6 +68,120 @@ py::dict stats_dict(const NavigatorStats& s) {
   d["covariance_not_pd"] = s.covariance_not_pd;
   d["max_covariance_asymmetry"] = s.max_covariance_asymmetry;
   return d;
+}
+
+/// A YAML document (the reports wheelins writes) as Python objects: maps as dicts, lists
+/// as lists, plain scalars as bool, int or float where they read as one, else str.
+py::object from_yaml(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Map: {
+      py::dict d;
+      for (const auto& kv : n) d[py::str(kv.first.as<std::string>())] = from_yaml(kv.second);
+      return d;
+    }
+    case YAML::NodeType::Sequence: {
+      py::list l;
+      for (const auto& x : n) l.append(from_yaml(x));
+      return l;
+    }
+    case YAML::NodeType::Scalar: {
+      const std::string v = n.Scalar();
+      if (n.Tag() == "!") return py::str(v);  // quoted
+      if (v == "true" || v == "false") return py::bool_(v == "true");
+      if (v == "null" || v == "~") return py::none();
+      char* end = nullptr;
+      const long long i = std::strtoll(v.c_str(), &end, 10);
+      if (!v.empty() && *end == '\0') return py::int_(i);
+      const double x = std::strtod(v.c_str(), &end);
+      if (!v.empty() && *end == '\0') return py::float_(x);
+      return py::str(v);
+    }
+    default:
+      return py::none();
+  }
+}
+py::object yaml_dict(const std::string& text) { return from_yaml(YAML::Load(text)); }
+
+/// The fault report as a dict: "events" (t_s, module, detected, action per detection, as
+/// faults.csv) and "modules" (each module's counts, as faults.csv's per-module lines).
+py::dict faults_dict(const std::vector<FaultEvent>& events, const std::vector<std::string>& names,
+                     const std::vector<ModuleFaultStats>& stats) {
+  py::list ev;
+  for (const FaultEvent& e : events) {
+    py::dict d;
+    d["t_s"] = e.t;
+    d["module"] = e.module;
+    d["detected"] = e.what;
+    d["action"] = e.action;
+    ev.append(d);
+  }
+  py::dict mods;
+  for (std::size_t i = 0; i < stats.size() && i < names.size(); ++i) {
+    // faults.csv's per-module columns, in its order.
+    static const std::pair<const char*, std::uint64_t ModuleFaultStats::*> counts[] = {
+        {"gaps", &ModuleFaultStats::gaps},
+        {"saturated_samples", &ModuleFaultStats::saturated_samples},
+        {"speed_rejected", &ModuleFaultStats::speed_rejected},
+        {"velocity_tests", &ModuleFaultStats::velocity_tests},
+        {"velocity_failed", &ModuleFaultStats::velocity_failed},
+        {"velocity_rejected", &ModuleFaultStats::velocity_rejected},
+        {"isolations", &ModuleFaultStats::isolations},
+        {"restarts", &ModuleFaultStats::restarts}};
+    py::dict d;
+    for (const auto& [key, member] : counts) d[key] = stats[i].*member;
+    d["seconds_unused"] = stats[i].seconds_unused;
+    mods[py::str(names[i])] = d;
+  }
+  py::dict out;
+  out["events"] = ev;
+  out["modules"] = mods;
+  return out;
+}
+
+/// The command line's words in a message, as a Python caller spells them.
+std::string python_message(std::string m) {
+  const std::pair<const char*, const char*> words[] = {
+      {"use --force to", "use force=True to"}, {"--force", "force=True"}, {"--set '", "setting '"},
+      {"--set ", "setting "}, {"--centralized", "centralized=True"}, {"--no-data-checks", "data_checks: false"}};
+  for (const auto& [cli, py] : words)
+    for (std::size_t at = m.find(cli); at != std::string::npos; at = m.find(cli, at + std::strlen(py)))
+      m.replace(at, std::strlen(cli), py);
+  return m;
+}
+
+/// `f()` on a worker thread while this one, holding the GIL every 10 ms, looks for signals:
+/// Ctrl-C raises the library's interrupt flag (the run stops at its next block and removes
+/// its unfinished output: nothing is left half-written) and KeyboardInterrupt is raised.
+template <class F>
+auto interruptible(F&& f) -> decltype(f()) {
+  clear_interrupt();
+  std::optional<decltype(f())> result;
+  std::exception_ptr error;
+  std::atomic<bool> done{false};
+  bool interrupted = false;
+  std::thread worker([&] {
+    try {
+      result.emplace(f());
+    } catch (...) {
+      error = std::current_exception();
+    }
+    done = true;
+  });
+  while (!done) {
+    {
+      py::gil_scoped_release free;
+      for (int k = 0; k < 10 && !done; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    if (!interrupted && PyErr_CheckSignals() != 0) {
+      interrupted = true;
+      request_interrupt();
+    }
+  }
+  worker.join();
+  clear_interrupt();
+  if (interrupted) throw py::error_already_set();  // the KeyboardInterrupt (or the handler's error)
+  if (error) std::rethrow_exception(error);
+  return std::move(*result);
 }
 
 /// What `wheelins run` takes besides the files, with its option names.
@@ -125,6 +248,9 @@ struct RunOutput {
   std::optional<std::string> metrics_json;
   NavigatorStats stats;
   std::string fault_report, noise_report, weights_report, calibration_report;
+  std::string noise_yaml, calibration_yaml;  ///< noise.yaml and calibration.yaml's text (empty: not estimated)
+  std::vector<FaultEvent> fault_events;
+  std::vector<ModuleFaultStats> fault_stats;
   std::vector<WeightRecord> weights;  ///< the reference weights of eq. (8) over time
   std::vector<std::string> files;
   std::string manifest;
@@ -161,11 +287,7 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
     o.records.push_back(r);
     if (evaluation) evaluation->add(r);
   };
-  RunResult res;
-  {
-    py::gil_scoped_release free;
-    res = run_navigation(req);
-  }
+  const RunResult res = interruptible([&] { return run_navigation(req); });
   if (evaluation) {
     try {
       o.metrics_json = eval::to_json(evaluation->finish());
@@ -177,6 +299,10 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
   o.fault_report = res.fault_report;
   o.noise_report = res.noise_report;
   o.calibration_report = res.calibration_report;
+  o.noise_yaml = noise_report_yaml(res.noise, req.manifest, req.nav.noise.enabled);
+  if (!res.calibration_report.empty()) o.calibration_yaml = calibration_yaml(res.calibration, req.manifest);
+  o.fault_events = res.fault_events;
+  o.fault_stats = res.fault_stats;
   o.weights_report = res.weights_report;
   o.weights = res.weights;
   for (const auto& f : res.files) o.files.push_back(f.string());
@@ -216,7 +342,7 @@ py::tuple evaluate(const py::object& truth_file, const py::object& trajectory, c
   eval::EvalOptions opt;
   opt.segment_length = segment;
   opt.max_gap = max_gap;
-  opt.align = align;
+  opt.align_origin = align;
   const eval::EvalResult res = eval::evaluate(truth, traj, earth::LocalFrame(o), opt);
   if (!series) return py::make_tuple(eval::to_json(res), py::none());
   py::array_t<double> a({res.series.size(), std::size_t(9)});
@@ -259,12 +385,8 @@ py::dict simulate(const py::object& out, const std::vector<std::string>& setting
   for (const auto& s : settings) cfg.apply_setting(s);
   if (!write_ideal) cfg.write_ideal = false;
   const std::string dir = *text(out);
-  sim::DatasetSummary sum;
-  {
-    const sim::Simulation simulation(cfg);
-    py::gil_scoped_release free;
-    sum = simulation.write(dir, force, progress);
-  }
+  const sim::Simulation simulation(cfg);
+  const sim::DatasetSummary sum = interruptible([&] { return simulation.write(dir, force, progress); });
   py::dict d;
   d["manifest"] = (std::filesystem::path(dir) / "manifest.yaml").string();
   d["scenario"] = sum.scenario;
@@ -468,6 +590,17 @@ class StreamNavigator {
   std::size_t record_count() const { return records_.size(); }
   py::dict stats() const { return stats_dict(nav_->stats()); }
   std::string fault_report() const { return fault_report_text(nav_->faults()); }
+  py::dict faults() const {
+    std::vector<ModuleFaultStats> st;
+    for (int i = 0; i < nav_->faults().size(); ++i) st.push_back(nav_->faults().stats(i));
+    return faults_dict(nav_->faults().events(), req_.modules, st);
+  }
+  /// The noise model now, as noise.yaml's text.
+  std::string noise_yaml() const {
+    std::vector<ModuleNoiseReport> n;
+    for (int i = 0; i < nav_->subsystem_count(); ++i) n.push_back(nav_->noise_report(i));
+    return noise_report_yaml(n, req_.manifest, req_.nav.noise.enabled);
+  }
   /// The warm-up's estimates (calibration.yaml's text; None with the manifest's geometry or
   /// during the warm-up).
   py::object calibration() const {
@@ -503,7 +636,18 @@ class StreamNavigator {
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "wheelins native core (use the wheelins package)";
-  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  // InputError as wheelins.InputError (a ValueError), its message in Python's words.
+  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      input_error(python_message(e.what()).c_str());
+    } catch (const Interrupted& e) {
+      PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+    }
+  });
+  m.def("yaml_dict", &yaml_dict, py::arg("text"), "A YAML report's text as dicts and lists");
   m.def("csv_columns", &trajectory_csv_header, "The trajectory CSV's column names, in order");
 
   py::class_<RunOutput>(m, "RunOutput")
@@ -512,6 +656,9 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("fault_report", &RunOutput::fault_report)
       .def_readonly("noise_report", &RunOutput::noise_report)
       .def_readonly("calibration_report", &RunOutput::calibration_report)
+      .def_readonly("noise_yaml", &RunOutput::noise_yaml)
+      .def_readonly("calibration_yaml", &RunOutput::calibration_yaml)
+      .def_property_readonly("faults", [](const RunOutput& r) { return faults_dict(r.fault_events, r.modules, r.fault_stats); })
       .def_readonly("weights_report", &RunOutput::weights_report)
       .def_property_readonly("weights_table",
                              [](const RunOutput& r) {
@@ -568,6 +715,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("record_count", &StreamNavigator::record_count)
       .def_property_readonly("stats", &StreamNavigator::stats)
       .def_property_readonly("fault_report", &StreamNavigator::fault_report)
+      .def_property_readonly("faults", &StreamNavigator::faults)
+      .def_property_readonly("noise_yaml", &StreamNavigator::noise_yaml)
       .def_property_readonly("calibration", &StreamNavigator::calibration)
       .def_property_readonly("calibration_report", &StreamNavigator::calibration_report);
 }

@@ -140,12 +140,12 @@ class Survey : public ::testing::Test {
   static fs::path imu_file(const fs::path& d, int group) {
     return d / (std::string(sim::Simulation::group_dir(group))) / "tri_C1_imu.bin";
   }
-  /// A copy of the dataset (its manifest, IMU files and truth) to trap.
+  /// A copy of the dataset (its manifest, IMU files, truth and odometer) to trap.
   static fs::path variant(const std::string& name) {
     const fs::path d = *dir_ / name;
     fs::remove_all(d);
     fs::create_directories(d);
-    for (const char* f : {"manifest.yaml", "GINS.bin"}) fs::copy_file(data() / f, d / f);
+    for (const char* f : {"manifest.yaml", "GINS.bin", "odo.bin"}) fs::copy_file(data() / f, d / f);
     for (int g = 0; g < 3; ++g) {
       fs::create_directories(imu_file(d, g).parent_path());
       fs::copy_file(imu_file(data(), g), imu_file(d, g));
@@ -485,8 +485,10 @@ TEST_F(Survey, NoDataChecksRunsTheManifestAsItIs) {
   std::vector<TrajectoryRecord> run;
   EXPECT_NO_THROW(run = navigate(m, triple(m), false));
   EXPECT_EQ(run.size(), baseline().size());
-  // Taken as it is, the right wheel drives backward: the run goes astray (62 m here).
-  EXPECT_GT(max_difference(run, baseline()), 10.0);
+  // Taken as it is, the right wheel drives backward. It went astray (62 m here) until the fault
+  // handling outvoted such a wheel (docs/faults.md): now it is isolated for the run, and the run
+  // stays with the untouched dataset's (0.28 m).
+  EXPECT_LT(max_difference(run, baseline()), 1.0);
 }
 
 // ------------------------------------------------------------------ steering

@@ -131,7 +131,7 @@ def test_run_weights_and_fixed_noise_as_the_cli(dataset, tmp_path):
     assert "(the given figures, held fixed)" in r.noise_report
     single = wheelins.run(dataset["manifest"], "single", duration=5.0)
     assert single.weights == {}
-    with pytest.raises(ValueError, match="expected equal or covariance"):
+    with pytest.raises(ValueError, match="expected equal, covariance or standalone"):
         wheelins.run(dataset["manifest"], "triple", weights="inverse", duration=5.0)
 
 
@@ -218,7 +218,8 @@ def test_streaming_navigator_estimates_the_geometry_over_a_warmup(dataset, tmp_p
         nav.covariance(0)
     nav.finish()
     same_as_csv(nav.trajectory, read_csv(tmp_path / "all" / "trajectory.csv"))
-    assert nav.calibration == (tmp_path / "all" / "calibration.yaml").read_text()
+    assert nav.calibration_yaml == (tmp_path / "all" / "calibration.yaml").read_text()
+    assert set(nav.calibration["modules"]) == {"left-C1", "body-C1"}
 
     static_end = read_csv(tmp_path / "all" / "trajectory.csv")["t_s"][0]  # navigation starts there
     nav = wheelins.Navigator(manifest, configuration="body-wheel", calibration="estimate", calibration_warmup=15)
@@ -309,3 +310,83 @@ def test_example_script_runs_headless(tmp_path):
     assert png.stat().st_size > 10000
     with open(png, "rb") as f:
         assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+def test_module_docstring_runs_as_a_doctest():
+    import doctest
+    failed, tried = doctest.testmod(wheelins, verbose=False, report=True)
+    assert tried > 5 and failed == 0
+
+
+def test_reports_are_dicts_with_their_text(dataset, tmp_path):
+    r = wheelins.run(dataset["manifest"], configuration="triple", out=tmp_path / "run")
+    import yaml as pyyaml  # python3-yaml (scripts/setup.sh): the files' own reading
+    assert r.noise == pyyaml.safe_load((tmp_path / "run" / "noise.yaml").read_text())
+    assert r.noise_yaml == (tmp_path / "run" / "noise.yaml").read_text()
+    assert r.calibration == pyyaml.safe_load((tmp_path / "run" / "calibration.yaml").read_text())
+    assert r.calibration_yaml == (tmp_path / "run" / "calibration.yaml").read_text()
+    assert "installation calibration" in r.calibration_report and isinstance(r.noise_report, str)
+    rows = [line for line in (tmp_path / "run" / "faults.csv").read_text().splitlines()
+            if line and not line.startswith("#")][1:]
+    assert len(r.faults["events"]) == len(rows)
+    assert set(r.faults["modules"]) == set(r.modules)
+    assert all(set(c) >= {"gaps", "isolations", "seconds_unused"} for c in r.faults["modules"].values())
+    manifest_only = wheelins.run(dataset["manifest"], configuration="single", calibration="manifest")
+    assert manifest_only.calibration is None and manifest_only.calibration_yaml is None
+    nav = wheelins.Navigator(dataset["manifest"], configuration="single")
+    assert set(nav.faults) == {"events", "modules"} and isinstance(nav.noise, dict)
+
+
+def test_messages_are_phrased_for_python(dataset, tmp_path):
+    """A misspelled keyword is a TypeError naming it (not the binding's signature), and the
+    messages name force=True, not the command line's --force."""
+    with pytest.raises(TypeError) as e:
+        wheelins.run(dataset["manifest"], configuration="triple", centralised=True)
+    assert "'centralised'" in str(e.value) and "did you mean 'centralized'" in str(e.value)
+    assert "Invoked with" not in str(e.value)
+    with pytest.raises(TypeError, match="'warmup'"):
+        wheelins.Navigator(dataset["manifest"], warmup=3)
+    with pytest.raises(TypeError, match="'segments'.*did you mean 'segment'"):
+        wheelins.evaluate(dataset["manifest"], dataset["manifest"], segments=10)
+    (tmp_path / "sim").mkdir()
+    (tmp_path / "sim" / "keep.txt").write_text("mine")
+    with pytest.raises(wheelins.InputError) as e:
+        wheelins.simulate(tmp_path / "sim", duration_s=20, chips=1)
+    assert "force=True" in str(e.value) and "--force" not in str(e.value)
+    with pytest.raises(wheelins.InputError) as e:
+        wheelins.simulate(tmp_path / "sim2", duration_s="long")
+    assert "--set" not in str(e.value) and "duration_s" in str(e.value)
+
+
+def test_ctrl_c_stops_a_long_call_at_once(tmp_path):
+    """Ctrl-C during a call into the library (here an hour's simulation, a minute or two of
+    work): KeyboardInterrupt within a fraction of a second, not at the end, and no data file
+    left behind."""
+    import _thread
+    import threading
+    import time
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    t0 = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        wheelins.simulate(tmp_path / "long", duration_s=3600, chips=1, write_ideal=False)
+    timer.join()
+    assert time.monotonic() - t0 < 2.0
+    assert [p for p in (tmp_path / "long").rglob("*") if p.is_file()] == []
+
+
+def test_ctrl_c_during_runs_leaves_only_complete_results(dataset, tmp_path):
+    """Runs back to back, Ctrl-C among them: KeyboardInterrupt, and every output directory
+    there is complete (an interrupted run removes its unfinished output)."""
+    import _thread
+    import threading
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        for k in range(200):
+            wheelins.run(dataset["manifest"], configuration="triple", calibration="manifest",
+                         out=tmp_path / f"run{k}")
+    timer.join()
+    # (on a busy machine the first run may be the one interrupted: then there is none)
+    for d in tmp_path.iterdir():
+        assert {p.name for p in d.iterdir()} >= {"trajectory.csv", "noise.yaml", "faults.csv"}, d

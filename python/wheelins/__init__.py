@@ -1,21 +1,34 @@
 """wheelins: dead reckoning for wheeled vehicles from wheel-mounted and body IMUs.
 
-The Python face of the C++ library (the native part is wheelins._core, pybind11):
+The Python face of the C++ library (the native part is wheelins._core, pybind11). A
+simulated dataset, a run on it and its figures (this example runs as a doctest):
 
-    import wheelins
-    info = wheelins.simulate("out/sim", duration_s=120, chips=1)
-    result = wheelins.run(info["manifest"], configuration="triple")
-    result.trajectory["north_m"], result.metrics["drift_rate"]
-    wheelins.evaluate(truth_file, result)            # or a trajectory file
+    >>> import tempfile, wheelins
+    >>> out = tempfile.mkdtemp()
+    >>> info = wheelins.simulate(out + "/sim", duration_s=40, static_s=10, chips=1, write_ideal=False)
+    >>> result = wheelins.run(info["manifest"], configuration="triple")
+    >>> result.metrics["rms_error_m"] < 1.0               # keyed as `wheelins evaluate --json`
+    True
+    >>> sorted(result.calibration["modules"]) == sorted(result.modules)   # calibration.yaml as a dict
+    True
+    >>> type(result.faults["events"]), sorted(result.faults["modules"]) == sorted(result.modules)  # faults.csv
+    (<class 'list'>, True)
+    >>> nav = wheelins.Navigator(info["manifest"], configuration="triple")
+    >>> nav.modules == result.modules
+    True
 
-    nav = wheelins.Navigator(info["manifest"], configuration="body-wheel")
-    nav.push("left-C1", t, gyro, accel)              # sample by sample, rad/s and m/s^2
-    nav.state["heading_deg"], nav.covariance("left-C1")
+A Navigator is fed sample by sample: nav.push("left-C1", t, gyro, accel) in rad/s and
+m/s^2, then nav.state["heading_deg"], nav.covariance("left-C1"). The reports are dicts
+(.noise, .calibration, .faults) with their text kept (.noise_report, .calibration_report,
+.fault_report; .noise_yaml and .calibration_yaml as the files hold them).
 
 Every error the command line reports as "error: MESSAGE" is raised as
-wheelins.InputError (a ValueError) with the same MESSAGE. See docs/python.md.
+wheelins.InputError (a ValueError) with the same MESSAGE, its options spelled as Python
+takes them (force=True). A misspelled keyword is a TypeError naming it. Ctrl-C stops a
+call (KeyboardInterrupt; nothing half-written is left). See docs/python.md.
 """
 
+import difflib as _difflib
 import json as _json
 import os as _os
 import shutil as _shutil
@@ -27,6 +40,30 @@ from . import _core
 from ._core import InputError
 
 __all__ = ["InputError", "Navigator", "Result", "csv_columns", "evaluate", "read_truth", "run", "simulate"]
+
+
+# The keyword arguments of run() and Navigator() beyond their named ones: the options of
+# `wheelins run` by name.
+_RUN_SETTINGS = ("speed", "centralized", "position_constraint", "fault_handling", "duration", "output_interval",
+                 "covariance_interval", "weights", "fixed_noise", "yaw_scale_factors", "calibration")
+_NAVIGATOR_SETTINGS = ("speed", "centralized", "position_constraint", "fault_handling", "duration",
+                       "output_interval", "covariance_interval", "yaw_scale_factors", "calibration",
+                       "calibration_warmup")
+_EVALUATE_OPTIONS = ("format", "truth_layout", "segment", "max_gap", "align", "origin")
+
+
+def _check_keywords(function, given, known):
+    """A TypeError naming a keyword `function` does not take (and the nearest it does)."""
+    for key in given:
+        if key not in known:
+            near = _difflib.get_close_matches(key, known, n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else ""
+            raise TypeError(f"{function}() got an unexpected keyword argument {key!r}{hint} "
+                            f"(it takes: {', '.join(known)})")
+
+
+def _yaml(text):
+    return None if not text else _core.yaml_dict(text)
 
 
 def csv_columns():
@@ -75,12 +112,15 @@ def simulate(out, *, force=False, progress=False, write_ideal=True, **settings):
 class Result:
     """A run: .trajectory (dict of numpy arrays keyed by the trajectory CSV's header names,
     in its units), .metrics (the evaluation against the manifest's truth, keyed as
-    `wheelins evaluate --json`; None without a truth file), .stats, .fault_report,
-    .noise_report (the noise model identified, as printed by `wheelins run`),
-    .calibration_report (the Wheel-IMUs' estimated installation geometry), .weights (the
+    `wheelins evaluate --json`; None without a truth file), .stats, .weights (the
     reference weights of eq. (8) at every constraint epoch, as weights.csv: dict of numpy
-    arrays, "t_s" and one per module; empty for a single IMU), .weights_report,
-    .modules, .files (written when run(out=...))."""
+    arrays, "t_s" and one per module; empty for a single IMU), .modules, .files (written
+    when run(out=...)). The reports as dicts and as text:
+    .noise (noise.yaml: the noise model identified), .noise_report (as printed by
+    `wheelins run`), .noise_yaml; .calibration (calibration.yaml: the installation
+    estimates; None with calibration="manifest"), .calibration_report, .calibration_yaml;
+    .faults ({"events": [{"t_s", "module", "detected", "action"}, ...], "modules": {name:
+    counts}}, as faults.csv), .fault_report; .weights_report."""
 
     def __init__(self, output):
         self._output = output
@@ -90,6 +130,11 @@ class Result:
         self.fault_report = output.fault_report
         self.noise_report = output.noise_report
         self.calibration_report = output.calibration_report
+        self.noise_yaml = output.noise_yaml
+        self.noise = _yaml(output.noise_yaml)
+        self.calibration_yaml = output.calibration_yaml or None
+        self.calibration = _yaml(output.calibration_yaml)
+        self.faults = output.faults
         self.weights_report = output.weights_report
         w = output.weights_table
         self.weights = {} if w.shape[0] == 0 else {
@@ -117,6 +162,7 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
     "constraint", "estimated"), calibration="manifest" (or "estimate", the default: the
     Wheel-IMUs' mounting and lever arm estimated from the data first).
     """
+    _check_keywords("run", filter_settings, _RUN_SETTINGS)
     if isinstance(chips, str):
         chips = [c for c in chips.split(",") if c]
     return Result(_core.run(manifest, configuration=configuration or "", chips=list(chips or []),
@@ -137,6 +183,7 @@ def evaluate(truth, trajectory, *, series=False, **options):
     series=True adds "series": the per-epoch errors as `wheelins evaluate --series` writes
     them (dict of numpy arrays: t_s, distance_m, err_n_m, ..., nees_h).
     """
+    _check_keywords("evaluate", options, _EVALUATE_OPTIONS)
     if isinstance(trajectory, Result):
         trajectory = trajectory._output
     text, table = _core.evaluate(truth, trajectory, series=series, **options)
@@ -176,6 +223,7 @@ class Navigator:
     """
 
     def __init__(self, manifest, configuration=None, chips=None, *, modules=None, config=None, **filter_settings):
+        _check_keywords("Navigator", filter_settings, _NAVIGATOR_SETTINGS)
         if isinstance(chips, str):
             chips = [c for c in chips.split(",") if c]
         tmp = None
@@ -234,9 +282,29 @@ class Navigator:
         return self._nav.fault_report
 
     @property
+    def faults(self):
+        """The fault report as a dict: {"events": [...], "modules": {...}} (as Result.faults)."""
+        return self._nav.faults
+
+    @property
+    def noise(self):
+        """The noise model now, as noise.yaml's dict (the text: .noise_yaml)."""
+        return _yaml(self._nav.noise_yaml)
+
+    @property
+    def noise_yaml(self):
+        return self._nav.noise_yaml
+
+    @property
     def calibration(self):
-        """With calibration="estimate": the warm-up's estimates as calibration.yaml's text
-        (None before the warm-up ends, and with the manifest's geometry)."""
+        """With calibration="estimate": the warm-up's estimates as calibration.yaml's dict
+        (None before the warm-up ends, and with the manifest's geometry); the text:
+        .calibration_yaml."""
+        return _yaml(self._nav.calibration)
+
+    @property
+    def calibration_yaml(self):
+        """The same as calibration.yaml's text (None as .calibration)."""
         return self._nav.calibration
 
     @property

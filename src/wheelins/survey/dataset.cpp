@@ -280,34 +280,45 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
   auto common = [&](std::size_t i, const std::vector<double>& x) {
     return shifted(signal(i, x), out.modules[i].clock.found ? out.modules[i].clock.offset : 0.0);
   };
-  // The static period: the first interval in which every wheel rests (or every body).
-  const std::vector<int>& still_set = wheels.empty() ? bodies : wheels;
+  // The static period: the first interval in which every module rests -- each wheel by its
+  // spin rate, each body by the spreads of its rate and specific force. Should the bodies
+  // never be quiet while the wheels rest (an idling engine shakes them), the wheels' common
+  // rest is taken and the survey says so.
   double from = -1e300, to = 1e300;
-  for (int k : still_set) {
-    from = std::max(from, out.modules[static_cast<std::size_t>(k)].start);
-    const std::size_t i = static_cast<std::size_t>(k);
+  std::vector<Signal> masks, body_masks;  // masks: the wheels' (every body's without wheels)
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool wheel = out.modules[i].kind == ModuleKind::kWheel;
+    if (!wheel && !wheels.empty()) {
+      const auto m = rest_mask(S[i], out.modules[i].traits);
+      body_masks.push_back(common(i, std::vector<double>(m.begin(), m.end())));
+      continue;
+    }
+    from = std::max(from, out.modules[i].start);
     to = std::min(to, S[i].t_last + (out.modules[i].clock.found ? out.modules[i].clock.offset : 0.0));
-  }
-  std::vector<Signal> masks;
-  for (int k : still_set) {
-    const std::size_t i = static_cast<std::size_t>(k);
     const auto m = rest_mask(S[i], out.modules[i].traits);
     masks.push_back(common(i, std::vector<double>(m.begin(), m.end())));
   }
-  double run_start = std::nan("");
-  for (double t = from; t <= to; t += step) {
-    bool all = !masks.empty();
-    for (const Signal& m : masks) all = all && m.at(t) > 0.5;
-    if (all && std::isnan(run_start)) run_start = t;
-    if (!all && !std::isnan(run_start)) {
-      if (t - run_start >= o.min_static + 2.0 * o.static_margin) {
-        out.static_period = Interval{run_start + o.static_margin, t - o.static_margin};
-        break;
+  auto first_rest = [&](bool with_bodies) -> std::optional<Interval> {
+    double run_start = std::nan("");
+    for (double t = from; t <= to; t += step) {
+      bool all = !masks.empty();
+      for (const Signal& m : masks) all = all && m.at(t) > 0.5;
+      if (with_bodies)
+        for (const Signal& m : body_masks) all = all && m.at(t) > 0.5;
+      if (all && std::isnan(run_start)) run_start = t;
+      if (!all && !std::isnan(run_start)) {
+        if (t - run_start >= o.min_static + 2.0 * o.static_margin)
+          return Interval{run_start + o.static_margin, t - o.static_margin};
+        run_start = std::nan("");
       }
-      run_start = std::nan("");
     }
+    return std::nullopt;
+  };
+  out.static_period = first_rest(true);
+  if (!out.static_period && !body_masks.empty()) {
+    out.static_period = first_rest(false);
+    out.static_bodies_quiet = !out.static_period;
   }
-
 
   // A body rests when the wheels do (a car body's own rates are too quiet to tell rest from
   // a smooth drive): its bias and up-axis from those bins, its yaw rate again with them.
@@ -505,11 +516,21 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
                           (f.steered ? "a steered wheel" : "not steered"));
   }
   if (out.static_period)
-    out.notes.push_back(fmt("static period [%.3f, %.3f] s (every wheel at rest; %.1f s)", out.static_period->start,
-                            out.static_period->end, out.static_period->length()));
+    out.notes.push_back(fmt("static period [%.3f, %.3f] s (%.1f s; ", out.static_period->start, out.static_period->end,
+                            out.static_period->length()) +
+                        static_period_basis(out) + ")");
   else
     out.notes.push_back("no static period found (the modules never rest together for " + fmt("%.1f s)", o.min_static));
   return out;
+}
+
+std::string static_period_basis(const DatasetSurvey& s) {
+  bool wheel = false, body = false;
+  for (const ModuleFinding& f : s.modules) (f.kind == ModuleKind::kWheel ? wheel : body) = true;
+  if (!wheel) return "every module at rest: rate and specific force quiet";
+  if (!body) return "every wheel at rest";
+  return s.static_bodies_quiet ? "every wheel at rest and every body quiet"
+                               : "every wheel at rest; the bodies are never quiet with them (an idling engine?): check it";
 }
 
 std::string survey_report(const DatasetSurvey& s) {
@@ -527,8 +548,8 @@ std::string survey_report(const DatasetSurvey& s) {
                   axle.c_str(), side.c_str(), steer.c_str(), clock.c_str());
     out += line;
   }
-  out += s.static_period ? fmt("static period %.2f .. %.2f s (%.1f s, every wheel at rest)\n", s.static_period->start,
-                               s.static_period->end, s.static_period->length())
+  out += s.static_period ? fmt("static period %.2f .. %.2f s (%.1f s, ", s.static_period->start,
+                               s.static_period->end, s.static_period->length()) + static_period_basis(s) + ")\n"
                          : std::string("no static period (the modules never rest together)\n");
   return out;
 }

@@ -17,8 +17,10 @@
 //    than an unsteered wheel's does (needs a Body-IMU for the vehicle's yaw rate);
 //  * a body's axes: its specific force follows the wheels' acceleration along the vehicle's
 //    forward axis and speed times yaw rate along its left axis (the centripetal acceleration);
-//  * the static period: the first interval in which every wheel rests (and every body,
-//    without wheels), on the common clock.
+//  * the static period: the first interval in which every module rests, on the common
+//    clock: every wheel's spin rate at its bias, and every body's rate and specific force
+//    as quiet as they get (an idling engine's shaking can keep a body from ever being
+//    that quiet while the wheels rest: then the wheels' rest, said so).
 #pragma once
 
 #include <filesystem>
@@ -91,9 +93,14 @@ struct ModuleFinding {
 struct DatasetSurvey {
   std::vector<ModuleFinding> modules;
   std::optional<Interval> static_period;  ///< on the common clock
+  /// The bodies are quiet in the static period too (false: only the wheels rest there).
+  bool static_bodies_quiet = true;
   std::vector<std::string> notes;         ///< what was found and why, one line each
   const ModuleFinding* find(const std::string& name) const;
 };
+
+/// What the static period was found on, in words.
+std::string static_period_basis(const DatasetSurvey& survey);
 
 /// A readable table: per module its kind, axle axis and the way forward, side, steering and
 /// clock offset, and the static period.

@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "wheelins/nav/types.hpp"
+#include "wheelins/survey/checks.hpp"
 
 namespace wheelins::survey {
 namespace {
@@ -62,6 +63,8 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
   const Manifest* veh = o.vehicle_from ? &*o.vehicle_from : nullptr;
   const std::string typical = " (typical " + vt.name + (o.vehicle_type_given ? "" : "; --vehicle-type to change") + ")";
   bool radius_todo = false, lever_todo = false, body_pos_todo = false, side_todo = false;
+  std::vector<double> left_y, right_y;  // known wheel positions' y, each side
+  bool any_steered = false;
   for (std::size_t i = 0; i < modules.size(); ++i) {
     const DraftModule& in = modules[i];
     const ModuleFinding* f = survey.find(in.name);
@@ -92,6 +95,8 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
                              ? fmt("from the data: spins about one axis (95th percentile %.1f rad/s)", f->traits.spin_p95)
                              : fmt("from the data: does not spin (95th percentile %.2f rad/s)", f->traits.spin_p95);
     const ModuleSpec* prior = veh ? veh->find(in.name) : nullptr;
+    const auto kp = o.known_positions.find(in.name);
+    const KnownPosition* known = kp == o.known_positions.end() ? nullptr : &kp->second;
     if (prior && prior->kind != f->kind)
       throw InputError("module '" + in.name + "': the vehicle manifest '" + veh->path.string() + "' calls it a " +
                        to_string(prior->kind) + " IMU, but its data " +
@@ -117,16 +122,28 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
         s.axle_axis = f->axle_axis;
         s.axle_sign = f->axle_sign;
       } else {
-        radius_todo = lever_todo = true;
+        radius_todo = true;
         note[key + "wheel_radius_m"] = "TODO: typical " + vt.name + " value; calibrate against a reference (wheelins calibrate --reference) or measure";
         note[key + "lever_arm_b_m"] = "estimated from the data by every run (calibration.yaml)";
-        std::string where = f->steered ? "front (steered)" : "rear axle";
-        if (f->side) where += std::string(", ") + (f->side > 0 ? "right" : "left");
-        else side_todo = true;
-        note[key + "position_v_m"] = "from the data: " + where + "; x, y TODO" + typical;
+        if (known) {
+          s.p_inV = known->p_inV;
+          note[key + "position_v_m"] = "from " + known->source + " (x forward, y right, z down)";
+          if (known->p_inV.y() < 0.0) left_y.push_back(known->p_inV.y());
+          if (known->p_inV.y() > 0.0) right_y.push_back(known->p_inV.y());
+          if (f->side && (known->p_inV.y() > 0.0) != (f->side > 0))
+            d.facts.push_back(in.name + ": " + known->source + " puts it on the " + (f->side > 0 ? "left" : "right") +
+                              ", its data on the " + (f->side > 0 ? "right" : "left") + ": check the frames");
+        } else {
+          lever_todo = true;
+          std::string where = f->steered ? "front (steered)" : "rear axle";
+          if (f->side) where += std::string(", ") + (f->side > 0 ? "right" : "left");
+          else side_todo = true;
+          note[key + "position_v_m"] = "from the data: " + where + "; x, y TODO" + typical;
+        }
         note[key + "mounting_deg"] = "estimated from the data by every run (calibration.yaml)";
       }
       s.steered = f->steered || (prior && prior->steered);
+      any_steered = any_steered || s.steered;
       if (f->steered) {
         note[key + "steered"] = fmt("from the data: its yaw rate leads the vehicle's by %.2f s", f->yaw_lead);
         d.facts.push_back(in.name + fmt(": a steered wheel (its yaw rate leads the vehicle's by %.2f s): "
@@ -154,6 +171,9 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
         carry_over(*prior, s);
         note[key + "mounting_deg"] = "from the vehicle manifest";
         note[key + "position_v_m"] = "from the vehicle manifest";
+      } else if (known) {
+        s.p_inV = known->p_inV;
+        note[key + "position_v_m"] = "from " + known->source + " (x forward, y right, z down); refined by every run relative to the wheels";
       } else {
         body_pos_todo = true;
         note[key + "position_v_m"] = "TODO: measure; refined by every run relative to the wheels" + typical;
@@ -166,8 +186,14 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
   if (survey.static_period) {
     m.static_start = round_to(survey.static_period->start, 0.01);
     m.static_end = round_to(survey.static_period->end, 0.01);
-    note["static_period_s"] = "from the data: every wheel at rest, on the reference clock";
+    note["static_period_s"] = "from the data: " + static_period_basis(survey) + ", on the reference clock";
+    if (!survey.static_bodies_quiet)
+      d.todo.push_back("static_period_s: the wheels rest there but the bodies are never quiet with them; check it");
   } else {
+    // Empty, where every module has data: a run refuses it and says why.
+    double start = -1e300;
+    for (const ModuleFinding& f : survey.modules) start = std::max(start, f.start);
+    if (!survey.modules.empty()) m.static_start = m.static_end = round_to(start, 0.01);
     d.todo.push_back("static_period_s: the modules never rest together at the start (a static period is needed to align)");
     note["static_period_s"] = "TODO: no common rest found";
   }
@@ -176,7 +202,17 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
   m.wheelbase = veh ? veh->wheelbase : vt.wheelbase;
   if (veh && veh->antenna_inV) m.antenna_inV = veh->antenna_inV;
   note["vehicle.track_m"] = veh ? "from the vehicle manifest" : "TODO: measure" + typical;
-  note["vehicle.wheelbase_m"] = veh ? "from the vehicle manifest" : "TODO: measure" + typical;
+  note["vehicle.wheelbase_m"] = veh           ? "from the vehicle manifest"
+                                : any_steered ? "TODO: measure" + typical
+                                              : "a typical value" + typical + "; used with steered wheels only";
+  const bool track_known = veh || (!left_y.empty() && !right_y.empty());
+  if (!veh && track_known) {
+    double l = 0.0, r = 0.0;
+    for (double y : left_y) l += y;
+    for (double y : right_y) r += y;
+    m.track_width = round_to(r / static_cast<double>(right_y.size()) - l / static_cast<double>(left_y.size()), 1e-4);
+    note["vehicle.track_m"] = "from the wheels' stated positions (the right's y less the left's)";
+  }
   m.heading_known = false;
   if (o.origin) {
     m.origin = *o.origin;
@@ -200,15 +236,54 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
   if (radius_todo)
     d.todo.insert(d.todo.begin(), "wheel_radius_m of every wheel: typical " + vt.name +
                                       " values written; `wheelins calibrate --reference` fits them to a GNSS track");
-  if (lever_todo) d.todo.push_back("wheel position_v_m (x, y) and vehicle.track_m, vehicle.wheelbase_m: typical values written");
+  if (lever_todo) d.todo.push_back("wheel position_v_m (x, y): typical values written");
+  if (!track_known) d.todo.push_back("vehicle.track_m: a typical value written");
+  if (!veh && any_steered) d.todo.push_back("vehicle.wheelbase_m: a typical value written (steered wheels are ahead of the rear axle by it)");
   if (body_pos_todo) d.todo.push_back("body position_v_m: a typical value written (a run refines it relative to the wheels)");
   if (side_todo) d.todo.push_back("which side each wheel is on (y of position_v_m): not told by the data (one wheel, or no turns)");
   if (o.truth_clock)
     for (const auto& n : o.truth_clock->notes) d.facts.push_back("reference clock: " + n);
-  d.notes.header = {"drafted by `wheelins import` from " + o.source,
+  d.notes.header = {"drafted by `" + o.tool + "` from " + o.source,
                     "what the data tell is filled in (see the comments); values marked 'TODO' are guesses",
                     "no initial heading: a run navigates in a local frame (heading 0 at the start) unless one is set",
                     "no noise figures: they are identified from the data (noise.yaml of a run)"};
+  return d;
+}
+
+ManifestDraft draft_from_files(const ManifestDraft& first, DraftOptions o, DatasetSurvey* report) {
+  std::vector<std::string> names;
+  std::vector<DraftModule> mods;
+  for (const ModuleSpec& s : first.manifest.modules) {
+    names.push_back(s.name);
+    DraftModule d;
+    d.name = s.name;
+    d.file = s.file;
+    d.layout = s.layout;
+    d.rate_hz = s.rate_hz;
+    mods.push_back(d);
+  }
+  const DatasetSurvey sv = survey_modules(survey_inputs(first.manifest, names));
+  if (first.manifest.truth_file) {
+    o.truth_file = *first.manifest.truth_file;
+    o.origin = first.manifest.origin;
+  }
+  ManifestDraft d = draft_from_survey(sv, mods, o);
+  d.manifest.path = first.manifest.path;
+  d.manifest.odometer_file = first.manifest.odometer_file;
+  if (first.manifest.heading_known && first.manifest.truth_file) {
+    d.manifest.initial_heading = first.manifest.initial_heading;
+    d.manifest.heading_known = true;
+    d.notes.comments["initial.heading_deg"] = "from the truth at the start";
+  }
+  d.layout = first.layout;
+  // The layout's facts but its static period (a single gyro's first motion: the survey's
+  // common rest of every module replaces it).
+  std::vector<std::string> facts;
+  for (const auto& f : first.facts)
+    if (f.rfind("static period", 0) != 0) facts.push_back(f);
+  d.facts.insert(d.facts.begin(), facts.begin(), facts.end());
+  d.facts.push_back("what the data say:\n" + survey_report(sv));
+  if (report) *report = sv;
   return d;
 }
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,6 +42,13 @@ struct DraftModule {
   std::string source;             ///< where the data came from (for the notes)
 };
 
+/// A module position the recording states (a ROS bag's /tf_static): written as it is, and
+/// not listed as a TODO.
+struct KnownPosition {
+  Vec3 p_inV = Vec3::Zero();  ///< [m] in the v-frame (x forward, y right, z down)
+  std::string source;         ///< where it was read, for the note ("/tf_static: base_link -> imu0")
+};
+
 struct DraftOptions {
   VehicleType vehicle = vehicle_type("car");
   bool vehicle_type_given = false;
@@ -50,12 +58,25 @@ struct DraftOptions {
   std::optional<std::filesystem::path> truth_file;  ///< as the manifest is to name it
   std::optional<ReferenceClockFit> truth_clock;
   std::optional<earth::Geodetic> origin;            ///< the reference at the start
+  /// Positions the recording states, by module name (they win over typical values; a
+  /// left and a right wheel among them give the track).
+  std::map<std::string, KnownPosition> known_positions;
   std::string name;
   std::string source;  ///< what was imported, for the header
+  std::string tool = "wheelins import";  ///< what drafted it, for the header
 };
 
 /// The drafted manifest (paths as given), its TODO notes, facts and TODO list.
 ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<DraftModule>& modules,
                                 const DraftOptions& options);
+
+/// The draft of a directory of IMU files side by side (`wheelins manifest DIR` of several
+/// <name>_imu.bin, and `wheelins import` of a ROS recording): `first` is the layout's draft
+/// (io/manifest_draft.hpp: the files, rates, truth, odometer and start); the modules are
+/// surveyed and drafted from what their data say (draft_from_survey), the truth, the
+/// odometer and a heading read from the truth kept. `options.name`, `source`, `vehicle`
+/// and `known_positions` are used; the truth and origin come from `first`. `report` (if
+/// given) receives the survey.
+ManifestDraft draft_from_files(const ManifestDraft& first, DraftOptions options, DatasetSurvey* report = nullptr);
 
 }  // namespace wheelins::survey

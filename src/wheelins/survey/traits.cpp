@@ -49,27 +49,34 @@ std::vector<std::uint8_t> wheel_rest(const Series& s, int axis, double rest_rate
   return rest;
 }
 
-/// Rest bins of a module that does not spin: the spread of its rate over 0.5 s within
-/// `factor` times the quietest tenth of the recording's.
+/// Rest bins of a module that does not spin: the spreads of its rate and of its specific
+/// force over 0.5 s both within `factor` times the quietest tenth of the recording's.
 std::vector<std::uint8_t> body_rest(const Series& s, double factor) {
   const std::size_t n = s.size();
   const std::size_t w = std::max<std::size_t>(2, static_cast<std::size_t>(std::lround(0.5 / s.dt)));
-  std::vector<double> spread(n, 0.0);
-  std::vector<double> windows;
-  for (std::size_t k = 0; k + w <= n; k += w) {
+  std::vector<double> spread_g(n, 1e300), spread_f(n, 1e300);
+  std::vector<double> windows_g, windows_f;
+  auto sd = [&](const std::vector<Vec3>& x, std::size_t k) {
     Vec3 mean = Vec3::Zero();
-    for (std::size_t j = k; j < k + w; ++j) mean += s.gyro[j];
+    for (std::size_t j = k; j < k + w; ++j) mean += x[j];
     mean /= static_cast<double>(w);
     double ss = 0.0;
-    for (std::size_t j = k; j < k + w; ++j) ss += (s.gyro[j] - mean).squaredNorm();
-    const double sd = std::sqrt(ss / static_cast<double>(w));
-    for (std::size_t j = k; j < k + w; ++j) spread[j] = sd;
-    windows.push_back(sd);
+    for (std::size_t j = k; j < k + w; ++j) ss += (x[j] - mean).squaredNorm();
+    return std::sqrt(ss / static_cast<double>(w));
+  };
+  for (std::size_t k = 0; k + w <= n; k += w) {
+    const double g = sd(s.gyro, k), f = sd(s.accel, k);
+    for (std::size_t j = k; j < k + w; ++j) spread_g[j] = g, spread_f[j] = f;
+    windows_g.push_back(g);
+    windows_f.push_back(f);
   }
-  for (std::size_t k = n - n % w; k < n; ++k) spread[k] = n >= w ? spread[n - n % w - 1] : 1e300;
-  const double quiet = percentile(windows, 0.1);
+  for (std::size_t k = n - n % w; k < n && n >= w; ++k) {
+    spread_g[k] = spread_g[n - n % w - 1];
+    spread_f[k] = spread_f[n - n % w - 1];
+  }
+  const double quiet_g = percentile(windows_g, 0.1), quiet_f = percentile(windows_f, 0.1);
   std::vector<std::uint8_t> rest(n, 0);
-  for (std::size_t k = 0; k < n; ++k) rest[k] = spread[k] <= factor * quiet;
+  for (std::size_t k = 0; k < n; ++k) rest[k] = spread_g[k] <= factor * quiet_g && spread_f[k] <= factor * quiet_f;
   return rest;
 }
 

@@ -30,7 +30,7 @@ struct TraitOptions {
   double min_spin_share = 0.8;   ///< the spin axis's share of the rotation in motion
   double rest_rate = 0.08;       ///< [rad/s] a resting wheel's spin rate stays within this of its bias
   double min_rest = 1.0;         ///< [s] shortest rest interval kept
-  double body_rest_factor = 3.0; ///< a body at rest: gyro std within this factor of its quietest 10 %
+  double body_rest_factor = 3.0; ///< a body at rest: gyro and accelerometer std within this factor of their quietest 10 %
 };
 
 struct ModuleTraits {
