@@ -2,6 +2,7 @@
 // direction, lever arm and relative radius, each Body-IMU's mounting) from a
 // recording, and writes the refined manifest and the estimates with their 1 sigma
 // (docs/filter.md section 15).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -34,11 +35,6 @@ struct Options {
 };
 
 
-bool same_file(const fs::path& a, const fs::path& b) {
-  std::error_code ec;
-  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
-}
-
 int run(const Options& o) {
   if (o.duration && (!std::isfinite(*o.duration) || *o.duration <= 0.0))
     throw InputError("--duration " + std::to_string(*o.duration) + ": must be a positive number of seconds");
@@ -48,15 +44,12 @@ int run(const Options& o) {
   const fs::path out(o.out);
   const fs::path report = o.report.empty() ? fs::path(out).replace_extension(".calibration.yaml")
                                            : fs::path(o.report);
-  // The input manifest is never overwritten, --force or not.
-  if (same_file(in, out) || same_file(in, report))
-    throw InputError("'" + out.string() + "' is the input manifest '" + in.string() +
-                     "': write the refined manifest to another file");
-  if (out == report) throw InputError("--out and --report name the same file '" + out.string() + "'");
-  check_output_target(out, o.force);
-  check_output_target(report, o.force);
-
+  // No input (the manifest, its recordings and truth) is ever overwritten, --force or not.
+  check_output_files({{out, "--out"}, {report, o.report.empty() ? "the report (--out with .calibration.yaml)" : "--report"}},
+                     {{in, "the input manifest"}}, o.force);
   const Manifest m = load_manifest(in);
+  check_output_files({{out, "--out"}, {report, "--report"}}, named_files(m.input_files(), "a data file of the manifest"),
+                     o.force);
   std::vector<std::string> modules = cli::split_list(o.modules);
   if (modules.empty()) {
     for (const auto& s : m.modules) modules.push_back(s.name);
@@ -82,30 +75,39 @@ int run(const Options& o) {
     ref = calibrate_against_reference(m, modules, cal, ro, stderr_sink());
     std::cout << reference_calibration_report(*ref);
   }
-  std::size_t unobserved = 0;
-  for (const auto& c : cal.wheels)
-    if (!c.axle_tilt_y.observed || !c.axle_tilt_z.observed || !c.lever_arm[1].observed ||
-        !c.lever_arm[2].observed || !c.wheel_radius.observed)
-      ++unobserved;
-  for (const auto& c : cal.bodies)
-    if (!c.tilt_x.observed || !c.tilt_y.observed || !c.yaw.observed || !c.position_x.observed ||
-        !c.position_y.observed)
-      ++unobserved;
+  // What was estimated, what was kept and what is still a guess: one list for the table
+  // above, calibration.yaml and the refined manifest's notes.
+  std::size_t undetermined = 0;
+  {
+    std::vector<std::string> seen;
+    for (const auto& d : calibration_decisions(cal))
+      if (d.outcome != CalibrationOutcome::kEstimated && !d.without_effect &&
+          std::find(seen.begin(), seen.end(), d.module) == seen.end())
+        seen.push_back(d.module);
+    undetermined = seen.size();
+  }
+  std::vector<std::string> measured;
+  if (ref)
+    for (const auto& w : ref->wheels)
+      if (w.radius.observed) measured.push_back(w.module);
+  ManifestAnnotations notes = calibration_notes(m, cal, read_manifest_notes(in), measured);
+  notes.header.push_back("refined by `wheelins calibrate` from " + in.string() + " (the estimates: " +
+                         report.filename().string() + ")");
   // Both files written in full before either is moved into place.
   for (const fs::path& f : {out, report})
     if (f.has_parent_path()) fs::create_directories(f.parent_path());
   AtomicTextFile refined(out, o.force), estimates(report, o.force);
   Manifest refined_manifest = apply_calibration(m, cal);
   if (ref) refined_manifest = apply_reference_calibration(refined_manifest, *ref);
-  refined.write(manifest_to_yaml(refined_manifest, out.has_parent_path() ? out.parent_path() : fs::path(".")));
+  refined.write(manifest_to_yaml(refined_manifest, out.has_parent_path() ? out.parent_path() : fs::path("."), notes));
   estimates.write(calibration_yaml(cal, m) + (ref ? reference_calibration_yaml(*ref, m) : std::string()));
   refined.commit();
   estimates.commit();
   std::cout << "wrote " << out.string() << "\nwrote " << report.string() << "\n";
-  if (unobserved > 0)
-    std::cerr << "warning: " << unobserved << " of " << cal.wheels.size() + cal.bodies.size()
-              << " modules have parts the recording does not determine (observed: false in '"
-              << report.string() << "'); those keep the manifest's values\n";
+  if (undetermined > 0)
+    std::cerr << "warning: " << undetermined << " of " << cal.wheels.size() + cal.bodies.size()
+              << " modules have parts the recording does not determine (weak or kept in '" << report.string()
+              << "' and in the table above); a weak part is drawn towards the manifest's value, a kept one is it\n";
   return 0;
 }
 

@@ -50,6 +50,7 @@ int run(const Args& a) {
   std::stringstream ss(a.only);
   for (std::string item; std::getline(ss, item, ',');)
     if (!item.empty()) spec.only.push_back(item);
+  study::check_experiment_only(spec.only, "--only");
   const std::string text = study::experiment_study_yaml(spec);
 
   if (a.prepare) {
@@ -86,6 +87,7 @@ int run(const Args& a) {
   out_opt.overwrite = a.force;
   out_opt.kind = "experiment";
   out_opt.inputs.push_back(manifest);
+  out_opt.notice = stderr_sink();
   OutputDir out_dir(final_out, out_opt);
   const fs::path out = out_dir.staging();
   study::write_file_atomic(out / "study.yaml", text);

@@ -18,61 +18,29 @@ struct Options {
   bool force = false;
 };
 
-/// Several IMU files side by side (the flat layout): what each module is, its axle, clock and
-/// mounting come from the data (survey/draft.hpp), not from the single-Wheel-IMU robot the
-/// layout was made for; the truth, odometer and start of the first draft are kept.
-wheelins::ManifestDraft survey_draft(const wheelins::ManifestDraft& first, const std::string& vehicle_type) {
-  using namespace wheelins;
-  std::vector<survey::ModuleInput> in;
-  std::vector<survey::DraftModule> mods;
-  for (const ModuleSpec& s : first.manifest.modules) {
-    survey::ModuleInput x;
-    x.name = s.name;
-    x.file = first.manifest.resolve(s.file);
-    x.read = imu_read_options(s);
-    x.read.pass_nonfinite = true;
-    in.push_back(x);
-    survey::DraftModule d;
-    d.name = s.name;
-    d.file = s.file;
-    d.layout = s.layout;
-    d.rate_hz = s.rate_hz;
-    mods.push_back(d);
-  }
-  const survey::DatasetSurvey sv = survey::survey_modules(in);
-  survey::DraftOptions o;
-  if (!vehicle_type.empty()) {
-    o.vehicle = survey::vehicle_type(vehicle_type);
-    o.vehicle_type_given = true;
-  }
-  o.name = first.manifest.name;
-  o.source = "the IMU files of " + first.manifest.name;
-  if (first.manifest.truth_file) {
-    o.truth_file = *first.manifest.truth_file;
-    o.origin = first.manifest.origin;
-  }
-  ManifestDraft d = survey::draft_from_survey(sv, mods, o);
-  d.manifest.path = first.manifest.path;
-  d.manifest.odometer_file = first.manifest.odometer_file;
-  if (first.manifest.heading_known && first.manifest.truth_file) {
-    d.manifest.initial_heading = first.manifest.initial_heading;
-    d.manifest.heading_known = true;
-    d.notes.comments["initial.heading_deg"] = "from the truth at the start";
-  }
-  d.layout = first.layout;
-  d.facts.insert(d.facts.begin(), first.facts.front());
-  d.facts.push_back("what the data say:\n" + survey::survey_report(sv));
-  return d;
-}
-
 int run(const Options& o) {
   using namespace wheelins;
   namespace fs = std::filesystem;
   const fs::path out = o.out.empty() ? fs::path(o.dir) / "manifest.yaml" : fs::path(o.out);
-  check_output_target(out, o.force);
+  const OutputFile target{out, o.out.empty() ? "the manifest (DIR/manifest.yaml)" : "-o"};
+  check_output_files({target}, {}, o.force);
   ManifestDraft d = draft_manifest(o.dir, out);
-  if (d.layout == "single-IMU" && (d.manifest.modules.size() > 1 || !o.vehicle_type.empty()))
-    d = survey_draft(d, o.vehicle_type);
+  // Several IMU files side by side (the flat layout): what each module is, its axle, clock
+  // and mounting come from the data (survey/draft.hpp), not from the single-Wheel-IMU robot
+  // the layout was made for.
+  if (d.layout == "single-IMU" && (d.manifest.modules.size() > 1 || !o.vehicle_type.empty())) {
+    survey::DraftOptions so;
+    if (!o.vehicle_type.empty()) {
+      so.vehicle = survey::vehicle_type(o.vehicle_type);
+      so.vehicle_type_given = true;
+    }
+    so.name = d.manifest.name;
+    so.source = "the IMU files of " + d.manifest.name;
+    so.tool = "wheelins manifest";
+    d = survey::draft_from_files(d, so);
+  }
+  // The recordings the draft names are its inputs: never replaced by it, --force or not.
+  check_output_files({target}, named_files(d.manifest.input_files(), "the recording"), o.force);
   save_manifest(d.manifest, out, d.notes);
   std::cout << "wrote " << out.string() << "\n";
   for (const auto& f : d.facts) std::cout << "  " << f << "\n";

@@ -55,9 +55,12 @@ int run(const Options& o) {
     OutputDirOptions d;
     d.overwrite = o.force;
     d.inputs.push_back(in);
+    d.notice = stderr_sink();
     dir = std::make_unique<OutputDir>(o.out, d);
     writers.push_back(make_trajectory_writer(TrajectoryFormat::kCsv, dir->staging() / "trajectory.csv"));
-    writers.push_back(make_trajectory_writer(TrajectoryFormat::kTum, dir->staging() / "trajectory.tum"));
+    TrajectoryWriterOptions tum;
+    tum.origin = m.origin;
+    writers.push_back(make_trajectory_writer(TrajectoryFormat::kTum, dir->staging() / "trajectory.tum", tum));
   }
   std::unique_ptr<eval::RunEvaluation> evaluation;
   if (m.truth_file)

@@ -25,7 +25,7 @@ struct RunArgs {
   std::string chips;
   std::string modules;
   std::string out;
-  std::string formats;
+  std::string formats, tum_frame;
   std::string speed;
   std::string weights;
   std::string yaw;
@@ -33,6 +33,7 @@ struct RunArgs {
   bool centralized = false;
   bool no_constraint = false;
   bool no_faults = false;
+  bool no_standstill = false;
   bool fixed_noise = false;
   bool no_evaluate = false;
   bool no_data_checks = false;
@@ -84,6 +85,7 @@ int run(const RunArgs& a) {
     cfg.formats.clear();
     for (const auto& f : cli::split_list(a.formats)) cfg.formats.push_back(trajectory_format_from_name(f));
   }
+  if (!a.tum_frame.empty()) cfg.tum_frame = tum_frame_from_name(a.tum_frame);
   if (!a.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(a.speed);
   if (!a.yaw.empty()) cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(a.yaw);
   if (!a.weights.empty()) {
@@ -96,6 +98,7 @@ int run(const RunArgs& a) {
   if (a.force) cfg.overwrite = true;
   if (a.duration) cfg.max_duration = *a.duration;
   if (a.no_faults) cfg.nav.faults.enabled = false;
+  if (a.no_standstill) cfg.nav.standstill.enabled = false;
   if (a.no_data_checks) cfg.data_checks = false;
   if (a.fixed_noise) cfg.nav.noise.enabled = false;
   if (a.output_interval) cfg.nav.output_interval = *a.output_interval;
@@ -168,19 +171,25 @@ const bool registered = cli::register_command(
       auto a = std::make_shared<RunArgs>();
       sub.add_option("config", a->config_file, "Run configuration (YAML; see docs/run-config.md)");
       sub.add_option("--manifest,-m", a->manifest, "Dataset manifest (overrides the config's)");
-      sub.add_option("--configuration,-c", a->configuration,
-                     "single | dual-wheel | body-wheel | triple (default: single)");
+      std::string configurations;  // from the presets, so the help cannot fall behind them
+      for (const auto& n : configuration_names())
+        configurations += (configurations.empty() ? "" : " | ") + n + (n == "single" ? " | single-right" : "");
+      sub.add_option("--configuration,-c", a->configuration, configurations + " (default: single)");
       sub.add_option("--chips", a->chips, "Chip per IMU, e.g. C1,C4 (default: the first of each)");
       sub.add_option("--modules", a->modules, "Explicit module names (instead of a configuration)");
       sub.add_option("--out,-o", a->out, "Output directory");
       sub.add_option("--formats", a->formats, "Trajectory formats: csv,tum,kml (default: all)");
+      sub.add_option("--tum-frame", a->tum_frame,
+                     "trajectory.tum's frame: ned (x north, y east, z down; the default) or enu (x east, "
+                     "y north, z up; body x forward, y left, z up: ROS, evo)");
       sub.add_option("--speed", a->speed, "Wheel speed sharing: own (default) | mean (paper)");
       sub.add_option("--yaw-scale-factors", a->yaw,
                      "Yaw-rate scale factors: auto (default: from the position constraint with a "
                      "Body-IMU, else held) | held | constraint | estimated");
       sub.add_option("--weights", a->weights,
                      "Reference weights k_i of eq. (8): equal (paper) | covariance (each "
-                     "subsystem's own uncertainty; weights.csv)");
+                     "subsystem's own uncertainty) | standalone (each subsystem's drift without the "
+                     "constraint; weights.csv)");
       sub.add_option("--calibration", a->calibration,
                      "installation geometry: estimate (default: from the data, "
                      "calibration.yaml) | manifest (as given)");
@@ -198,6 +207,9 @@ const bool registered = cli::register_command(
       sub.add_flag("--no-fault-handling", a->no_faults,
                    "Use every sample and module as it comes (no outage, saturation, slip or "
                    "fault isolation)");
+      sub.add_flag("--no-standstill", a->no_standstill,
+                   "No zero-velocity detection: a standing vehicle gets the wheel-speed updates of a "
+                   "moving one (docs/faults.md, \"Standing still\")");
       sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
       sub.add_option("--antenna", a->antenna,
                      "Evaluation: the truth's antenna X,Y,Z in the vehicle frame [m] (default: the manifest's "

@@ -97,6 +97,7 @@ int run(const Options& o) {
   if (!o.config.empty()) out_opt.inputs.push_back(o.config);
   if (cfg.scenario != "default") out_opt.inputs.push_back(cfg.scenario);
   if (cfg.speed_file) out_opt.inputs.push_back(*cfg.speed_file);
+  out_opt.notice = stderr_sink();
   OutputDir out(o.out, out_opt);
   const sim::Simulation simulation(cfg);
   const auto sum = simulation.write(out.staging(), false, !o.quiet);

@@ -1,7 +1,9 @@
-// Fuzzes the configuration paths: the YAML loaders (dataset manifest, run configuration),
-// the simulator's key=value settings (--set, and the options that map onto them), and the
-// number checks every command-line number goes through (the run request's ranges, the
-// evaluation options, the simulator's ranges). Mode = first byte % 4.
+// Fuzzes the configuration paths: the YAML loaders (dataset manifest, run configuration,
+// study file with its first and last job resolved: the simulator settings and manifest
+// edits it builds), the simulator's key=value settings (--set, and the options that map
+// onto them), and the number checks every command-line number goes through (the run
+// request's ranges, the evaluation options, the simulator's ranges). Mode = first byte % 5.
+// One target for every YAML loader, so that the fuzzing time of the CI stays as it is.
 #include <cstring>
 
 #include "fuzz_common.hpp"
@@ -10,6 +12,7 @@
 #include "wheelins/run/run_config.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/sim/config.hpp"
+#include "wheelins/study/spec.hpp"
 
 using namespace wheelins;
 
@@ -84,6 +87,13 @@ void settings(const std::uint8_t* data, std::size_t size) {
   }
 }
 
+void study_file(const std::filesystem::path& file) {
+  const study::Study s = study::Study::load(file);
+  if (s.job_count() == 0) return;
+  (void)s.job(0);
+  (void)s.job(s.job_count() - 1);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -91,10 +101,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const auto file = fuzz::scratch_file("config.yaml");
   const WarningSink quiet = [](const std::string&) {};
   try {
-    switch (data[0] % 4) {
+    switch (data[0] % 5) {
       case 0: fuzz::write_bytes(file, data + 1, size - 1); load_manifest(file, quiet); break;
       case 1: fuzz::write_bytes(file, data + 1, size - 1); load_run_config(file, quiet); break;
       case 2: settings(data + 1, size - 1); break;
+      case 4: fuzz::write_bytes(file, data + 1, size - 1); study_file(file); break;
       default: numbers(data + 1, data + size); break;
     }
   } catch (const InputError&) {

@@ -67,6 +67,8 @@ d=$(variant repeated '' "$put
 rows[8000][0] = rows[7999][0]; put(rows)"); case_ "timestamp repeated" run "$d"
 d=$(variant gap '' "$put
 put(rows[:7000] + rows[7400:])"); case_ "2 s gap (warning; handled as an outage)" run "$d"
+d=$(variant jump '' "$put
+put(rows[:7000] + [[r[0] + 1e9] + r[1:] for r in rows[7000:]])"); case_ "timestamps jumping 1e9 s ahead (error: no data for longer than faults.max_outage_s, naming the record)" run "$d"
 d=$(variant late-start '' "$put
 put(rows[6200:])"); case_ "IMU data start after the static period" run "$d"
 d=$(variant early-end '' "$put
@@ -153,17 +155,34 @@ python3 - "$d/out/trajectory.csv" <<'EOF'
 import sys; p = sys.argv[1]; L = open(p).read().split('\n'); f = L[500].split(','); f[1] = 'nan'; L[500] = ','.join(f); open(p, 'w').write('\n'.join(L))
 EOF
 case_ "evaluate: a trajectory with a NaN" "$W" evaluate --truth "$d/GINS.bin" --traj "$d/out/trajectory.csv"
+# Evaluation coverage and rate (docs/evaluation.md): a warning and "comparable": false.
+head -n $(( $(wc -l < "$d/out/trajectory.csv") * 13 / 100 )) "$d/out/trajectory.csv" > "$d/out/first13.csv"
+case_ "evaluate: a trajectory missing 87 % of its records (warning: NOT comparable; exit 0)" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$d/out/first13.csv"
+awk 'NR <= 2 || NR == n' n=$(wc -l < "$d/out/trajectory.csv") "$d/out/trajectory.csv" > "$d/out/two.csv"
+case_ "evaluate: a trajectory of two records (warning: NOT comparable; exit 0)" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$d/out/two.csv"
+d=$(variant no-odo 's#^odometer: .*#odometer: "odo-gone.bin"#'); case_ "manifest naming a missing odometer file" run "$d"
+d=$(variant millis '' "$put
+t1 = rows[0][0] + 31.0
+put([[r[0] * 1000.0 if r[0] > t1 else r[0]] + r[1:] for r in rows])"); case_ "IMU times in ms after the static period (bounded memory: ulimit -v 2 GB)" run "$d"
 
 echo "| **runaway work, unbounded memory** | | |"
 case_ "simulate --duration -10" "$W" simulate --out "$S/sd1" --duration -10 -q
 case_ "simulate --duration -10 --set chips=2 (names --duration)" "$W" simulate --out "$S/sd2" --duration -10 --set chips=2 -q
 case_ "simulate --duration 1e9" "$W" simulate --out "$S/sd3" --duration 1e9 -q
 case_ "simulate --cruise-speed 1e-5" "$W" simulate --out "$S/sc1" --cruise-speed 1e-5 -q
+case_ "simulate: a gyro full scale of 0.001 deg/s (run refuses it)" "$W" simulate --out "$S/sg1" --set errors.gyro_range_deg_s=0.001 -q
+case_ "simulate --static 0 (no alignment possible)" "$W" simulate --out "$S/ss0" --static 0 -q
+case_ "simulate: a wheel's 5 m lever arm (run refuses it)" "$W" simulate --out "$S/sl5" --set "vehicle.left-wheel.lever_arm_m=[5,0,0]" -q
 case_ "simulate --cruise-speed -1" "$W" simulate --out "$S/sc2" --cruise-speed -1 -q
 case_ "simulate --rate 1e-3" "$W" simulate --out "$S/sr" --rate 1e-3 -q
 case_ "simulate --laps 1000000" "$W" simulate --out "$S/sl" --laps 1000000 -q
 case_ "evaluate --segment 1e-9" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/ok/out2/trajectory.csv" --segment 1e-9
 case_ "evaluate --max-gap -1" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/ok/out2/trajectory.csv" --max-gap -1
+case_ "evaluate --frame nwu" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/ok/out2/trajectory.csv" --frame nwu
+case_ "evaluate --frame enu for a CSV trajectory" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/ok/out2/trajectory.csv" --frame enu
+case_ "evaluate --align --align-origin (two alignments)" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/ok/out2/trajectory.csv" --align --align-origin
+printf '# frame: enu\n0 0 0 0 0 0 0 1\n' > "$S/enu.tum"
+case_ "evaluate --frame ned for a TUM file that says enu" "$W" evaluate --truth "$S/ok/GINS.bin" --traj "$S/enu.tum" --frame ned
 case_ "/dev/zero as the manifest" "$W" run -m /dev/zero -q -o "$S/z1"
 case_ "/dev/zero as the run config" "$W" run /dev/zero -q
 d=$(variant text-zero 's#layout: binary#layout: text#; s#tri_C1_imu.bin#zero.txt#'); ln -sf /dev/zero "$d/left-wheel-imu/zero.txt"; case_ "/dev/zero as a text IMU file" run "$d"
@@ -261,3 +280,60 @@ s = lambda t: struct.pack('<I', len(t)) + t
 h = s(b'ros2') + s(b'x')
 open(sys.argv[1], 'wb').write(b'\x89MCAP0\r\n' + b'\x01' + struct.pack('<Q', len(h)) + h + b'\x06' + struct.pack('<Q', 1000))" "$S/cut.mcap"
 case_ "import: an MCAP file cut inside a chunk" imp "$S/cut.mcap"
+
+echo "| **one YAML path, one rule for output paths** | | |"
+python3 - "$S/ok/manifest.yaml" "$S/laughs.yaml" <<'PYEOF'
+import sys
+s = open(sys.argv[1]).read() + 'l0: &l0 [' + ', '.join(['"lol"'] * 10) + ']\n'
+for k in range(1, 9):
+    s += 'l%d: &l%d [' % (k, k) + ', '.join(['*l%d' % (k - 1)] * 10) + ']\n'
+open(sys.argv[2], 'w').write(s)
+PYEOF
+case_ "manifest with nested aliases (billion laughs, 1 KB)" "$W" run -m "$S/laughs.yaml" -c single -q -o "$S/laughs-out"
+printf 'name: typed\nsimulate:\n  duration_s: 60\nseeds: [1, abc]\n' > "$S/typed.yaml"
+case_ "study: seeds [1, abc]" "$W" study plan "$S/typed.yaml"
+case_ "experiment --only quadruple" "$W" experiment "$S/ok" --only quadruple -o "$S/quad"
+d=$(variant escaped 's#name: "left-C1"#name: "../../escaped"#'); case_ "module named ../../escaped" run "$d"
+d=$(variant comma 's#name: "left-C1"#name: "left,C1"#'); case_ "module name with a comma" run "$d"
+d=$(variant reserved 's#name: "left-C1"#name: "trajectory"#'); case_ "module named trajectory" run "$d"
+d=$(variant samefile 's#left-wheel-imu/tri_C1_imu.bin#right-wheel-imu/tri_C1_imu.bin#'); case_ "two modules reading one IMU file" run "$d"
+case_ "run -o ''" "$W" run -m "$S/ok/manifest.yaml" -c single -q -o ''
+case_ "study run --job ''" "$W" study run "$S/typed.yaml" --job ''
+"$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/kept" --formats csv >/dev/null 2>&1
+echo "my notes" > "$S/kept/notes.txt"
+out=$("$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/kept" --formats csv --force 2>&1 >/dev/null | grep -c "kept")
+echo "| run --force over results holding the user's notes.txt | $([ -f "$S/kept/notes.txt" ] && echo 0 || echo 1) | notes.txt $([ -f "$S/kept/notes.txt" ] && echo kept || echo LOST); $out line(s) naming it |"
+mkdir -p "$S/linked-real"; ln -sfn "$S/linked-real" "$S/linked"
+"$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/linked" --formats csv >/dev/null 2>&1
+"$W" run -m "$S/ok/manifest.yaml" -c single -q -o "$S/linked" --formats csv --force >/dev/null 2>&1
+echo "| run -o LINK --force | $? | the link $([ -L "$S/linked" ] && echo stays a link || echo WAS REPLACED); results in its target: $(ls "$S/linked-real" | tr '\n' ' ') |"
+T2="$S/ok/GINS.bin"; [ -f "$T2" ] || T2=$(ls "$S/ok"/*.bin | head -1)
+cp "$T2" "$S/evtruth.bin"
+case_ "evaluate --json F --series F" "$W" evaluate --truth "$S/evtruth.bin" --traj "$S/kept/trajectory.csv" --json "$S/F" --series "$S/F"
+echo "| F left behind after it | $([ -e "$S/F" ] && echo 1 || echo 0) | |"
+case_ "evaluate --series = the trajectory, --force" "$W" evaluate --truth "$S/evtruth.bin" --traj "$S/kept/trajectory.csv" --series "$S/kept/trajectory.csv" --force
+case_ "calibrate --report = the input manifest" "$W" calibrate -m "$S/ok/manifest.yaml" -o "$S/refined.yaml" --report "$S/ok/manifest.yaml" --force
+case_ "manifest -o = a recording of the dataset, --force" "$W" manifest "$S/ok" -o "$S/ok/$IMU" --force
+# A ROS 1 bag whose index entry points past its chunk (crashed the ROS bag library, signal 11).
+python3 - "$S/badindex.bag" <<'EOF'
+import struct, sys
+def rec(fields, data):
+    h = b''.join(struct.pack('<I', len(k) + 1 + len(v)) + k + b'=' + v for k, v in fields)
+    return struct.pack('<I', len(h)) + h + struct.pack('<I', len(data)) + data
+u32 = lambda v: struct.pack('<I', v); u64 = lambda v: struct.pack('<Q', v)
+conn_hdr = b''.join(struct.pack('<I', len(f)) + f for f in [b'topic=/imu', b'type=sensor_msgs/Imu',
+                                                            b'md5sum=6a62c6daae103f4ff57a132d6f95cec2'])
+conn = rec([(b'op', b'\x07'), (b'conn', u32(0)), (b'topic', b'/imu')], conn_hdr)
+msg = rec([(b'op', b'\x02'), (b'conn', u32(0)), (b'time', u64(5))], b'\0' * 300)
+chunk_data = conn + msg
+head = b'#ROSBAG V2.0\n'
+bag_header_len = len(rec([(b'op', b'\x03'), (b'index_pos', u64(0)), (b'conn_count', u32(1)), (b'chunk_count', u32(1))], b' ' * 4000))
+chunk = rec([(b'op', b'\x05'), (b'compression', b'none'), (b'size', u32(len(chunk_data)))], chunk_data)
+index = rec([(b'op', b'\x04'), (b'ver', u32(1)), (b'conn', u32(0)), (b'count', u32(1))], u64(5) + u32(1 << 30))
+index_pos = len(head) + bag_header_len + len(chunk) + len(index)
+bag_header = rec([(b'op', b'\x03'), (b'index_pos', u64(index_pos)), (b'conn_count', u32(1)), (b'chunk_count', u32(1))], b' ' * 4000)
+info = rec([(b'op', b'\x06'), (b'ver', u32(1)), (b'chunk_pos', u64(len(head) + bag_header_len)), (b'start_time', u64(5)),
+            (b'end_time', u64(5)), (b'count', u32(1))], u32(0) + u32(1))
+open(sys.argv[1], 'wb').write(head + bag_header + chunk + index + conn + info)
+EOF
+case_ "import: a ROS 1 bag whose index points past its chunk" imp "$S/badindex.bag"

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "io_test_util.hpp"
@@ -267,6 +268,40 @@ TEST(EvalPlots, GnuplotDrawsPngs) {
   int listed = 0;
   for (const auto& f : w.files) listed += f.extension() == ".png";
   EXPECT_EQ(listed, pngs);
+}
+
+// Two reports drawing the same figures into one directory at once (issue 33, item 17): each
+// gnuplot writes its own temporary, so neither finds its image gone nor warns "exit 0".
+TEST(EvalPlots, TwoRendersIntoOneDirectoryAtOnceShareNoTemporary) {
+  if (!gnuplot_available()) GTEST_SKIP() << "gnuplot is not installed (apt-get install gnuplot-nox)";
+  ScratchDir dir;
+  eval::PlotOptions o;
+  o.render = false;
+  write(dir, false, o);
+  const std::vector<std::string> names = {"trajectory", "fig7_dual_wheel", "fig8_body_wheel", "fig9_triple",
+                                          "fig10_drift_rate"};
+  for (int round = 0; round < 3; ++round) {
+    std::vector<std::string> warnings[2];
+    std::vector<fs::path> drawn[2];
+    std::vector<std::thread> both;
+    for (int k = 0; k < 2; ++k)
+      both.emplace_back([&, k] {
+        drawn[k] = eval::render_gnuplot(dir / "plots", names, [&, k](const std::string& m) {
+          warnings[k].push_back(m);
+        });
+      });
+    for (auto& t : both) t.join();
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_TRUE(warnings[k].empty()) << warnings[k].front();
+      EXPECT_EQ(drawn[k].size(), names.size());
+    }
+  }
+  for (const auto& n : names) {
+    const fs::path png = dir / "plots" / (n + ".png");
+    ASSERT_TRUE(fs::exists(png)) << png;
+    EXPECT_EQ(read_all(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << png;
+    EXPECT_FALSE(iotest::partial_left(png));
+  }
 }
 
 TEST(EvalPlots, FigureRunsArePaperChipsOrTheClosestCombination) {

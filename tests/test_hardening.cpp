@@ -248,6 +248,41 @@ TEST(HardeningSim, SettingsAreCheckedOnceAllAreIn) {
   EXPECT_HAS(error_of([&] { s.validate(); }), "must be in [0.05, 60]");
 }
 
+// `simulate` refuses what `run` would refuse of its dataset (issue 33, "also seen"): a gyro full
+// scale below a manifest's range, --static too short for the alignment, a wheel's lever arm
+// or a module's position beyond a manifest's limits; at the limits the dataset loads.
+TEST(HardeningSim, SimulateRefusesSettingsWhoseDatasetRunRefuses) {
+  auto fails = [](const std::string& setting, double static_s = 10.0) {
+    sim::SimConfig c;
+    c.static_duration = static_s;
+    if (!setting.empty()) c.apply_setting(setting);
+    return error_of([&] { c.validate(); });
+  };
+  EXPECT_HAS(fails("errors.gyro_range_deg_s=0.001"), "errors.gyro_range_deg_s");
+  EXPECT_HAS(fails("errors.gyro_range_deg_s=0.001"), "gyro_range_dps");
+  EXPECT_HAS(fails("", 0.0), "static_s (--static)");
+  EXPECT_HAS(fails("", 0.0), "at least 10");
+  EXPECT_HAS(fails("vehicle.left-wheel.lever_arm_m=[5, 0, 0]"), "vehicle.left-wheel.lever_arm_m");
+  EXPECT_HAS(fails("vehicle.body.position_m=[0, 0, 25]"), "vehicle.body.position_m");
+  // Without the saturation effect the full scale is not written: any value is harmless.
+  sim::SimConfig ideal;
+  ideal.set_profile("ideal");
+  ideal.apply_setting("errors.gyro_range_deg_s=0.001");
+  EXPECT_NO_THROW(ideal.validate());
+
+  // Just inside every limit: the dataset's manifest loads.
+  iotest::ScratchDir dir;
+  sim::SimConfig c;
+  c.duration = 2.0;
+  c.static_duration = 10.0 / c.rate_hz;
+  c.apply_setting("errors.gyro_range_deg_s=10");
+  c.apply_setting("vehicle.left-wheel.lever_arm_m=[0.98, 0, 0]");
+  c.apply_setting("vehicle.body.position_m=[19.9, 0, 0]");
+  ASSERT_NO_THROW(c.validate());
+  sim::Simulation{c}.write(dir / "ds", false, false);
+  EXPECT_NO_THROW(load_manifest(dir / "ds" / "manifest.yaml"));
+}
+
 // ------------------------------------------------------------------------- the input checks
 
 TEST_F(Hardening, StaticPeriodFormatAndRateAreCheckedFromTheData) {

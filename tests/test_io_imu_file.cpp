@@ -269,6 +269,15 @@ TEST(IoImuFile, TimestampsMustStrictlyIncrease) {
   EXPECT_HAS(back, "back.bin': record 6 (0-based), column 0 (t)");
   EXPECT_HAS(back, "goes back from the previous record's 50.025");
   EXPECT_HAS(back, "strictly increasing");
+
+  // Issue 33, 3: times in milliseconds after the static period: a jump of 1e8 s is an error
+  // at its record, not a gap to carry (the calibration pass ran out of memory over it).
+  rows = make_rows(10, 100000.0, 200.0);
+  for (std::size_t k = 6; k < rows.size(); ++k) rows[k].t *= 1000.0;
+  write_doubles(dir / "ms.bin", flatten(rows));
+  const std::string ms = read_all_error(dir / "ms.bin");
+  EXPECT_HAS(ms, "ms.bin': record 6 (0-based), column 0 (t)");
+  EXPECT_HAS(ms, "more than a day (are the times in another unit than seconds, e.g. milliseconds");
 }
 
 TEST(IoImuFile, MissingDirectoryTruncatedAndEmptyFiles) {

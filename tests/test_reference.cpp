@@ -476,7 +476,7 @@ TEST_F(StartAlignedEvaluation, TurnedAndShiftedTrajectoryScoresLikeTheOriginal) 
 
   // Both alignments at once are an error.
   eval::EvalOptions both = o;
-  both.align = true;
+  both.align_origin = true;
   EXPECT_HAS(error_of([&] { eval::evaluate(truth, moved, frame, both); }), "two alignments");
 }
 

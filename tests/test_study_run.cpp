@@ -159,6 +159,34 @@ TEST(StudyRun, FailedJobIsReported) {
   EXPECT_HAS(strict.out, "job 1 (1 | bad): failed");
 }
 
+// A results directory holding the user's own report.md and plot script (issue 33, item 5):
+// the jobs run, the report names the file it will not replace, and the user's files survive.
+TEST(StudyRun, AReportNeverReplacesTheUsersOwnFiles) {
+  ScratchDir d;
+  put(d / "s.yaml", std::string(kSmall).substr(0, std::string(kSmall).find("seeds")) +
+                        "seeds: [1]\nconfigurations: [single]\n");
+  put(d / "r" / "report.md", "# my own notes\n");
+  put(d / "r" / "plots" / "drift.gp", "# my own script\n");
+  const Cmd r = shell(bin() + " study run s.yaml --results r --no-plots", d.path());
+  EXPECT_NE(r.code, 0);
+  EXPECT_HAS(r.err, "report.md");
+  EXPECT_HAS(r.err, "not written by a study report");
+  EXPECT_EQ(slurp(d / "r" / "report.md"), "# my own notes\n");
+  EXPECT_EQ(slurp(d / "r" / "plots" / "drift.gp"), "# my own script\n");
+  EXPECT_TRUE(fs::exists(d / "r" / "jobs" / "0.json"));  // the job's result is kept
+  // Reporting again (there is no --force for a report) refuses the same way.
+  const Cmd again = shell(bin() + " study report s.yaml --results r --no-plots", d.path());
+  EXPECT_NE(again.code, 0);
+  EXPECT_HAS(again.err, "not written by a study report");
+  EXPECT_EQ(slurp(d / "r" / "report.md"), "# my own notes\n");
+  // Once the user moves their notes away, the report is written.
+  fs::remove(d / "r" / "report.md");
+  fs::remove(d / "r" / "plots" / "drift.gp");
+  const Cmd ok = shell(bin() + " study report s.yaml --results r --no-plots", d.path());
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_HAS(slurp(d / "r" / "report.md"), "# Study");
+}
+
 TEST(StudyRun, SameReportHoweverTheJobsRan) {
   ScratchDir d;
   put(d / "s.yaml", kSmall);
@@ -226,7 +254,17 @@ TEST(StudyRun, SameReportHoweverTheJobsRan) {
   if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
     EXPECT_TRUE(fs::exists(d / "one" / "plots" / "drift.png"));
     EXPECT_TRUE(fs::exists(d / "one" / "plots" / "heading.png"));
+    EXPECT_TRUE(fs::exists(d / "one" / "plots" / "paired_drift.png"));
   }
+  // The plots say what their axes and marks are: an x label, the bars explained in the key,
+  // and the paired differences of the compared configurations around a zero line.
+  const std::string gp = slurp(d / "one" / "plots" / "drift.gp");
+  EXPECT_HAS(gp, "set xlabel \"");
+  EXPECT_HAS(gp, "square and bars: mean and its ");
+  const std::string paired = slurp(d / "one" / "plots" / "paired_drift.gp");
+  EXPECT_HAS(paired, "triple - single");
+  EXPECT_HAS(paired, "set arrow from graph 0, first 0");
+  EXPECT_HAS(md, "plots/paired_drift.png");
   // A done job is not run again; a changed setting makes the results stale, and they are kept.
   const Cmd resume = shell(bin() + " study run s.yaml --results one --cache cache", d.path());
   EXPECT_EQ(resume.code, 0);
@@ -256,6 +294,7 @@ TEST(StudyRun, ExperimentIsABuiltInStudy) {
       bin() + " experiment data -o one --only single,triple,centralized --no-plots -q", d.path());
   ASSERT_EQ(one.code, 0) << one.err;
   EXPECT_HAS(one.out, "## Table 4: single Wheel-INS");
+  EXPECT_HAS(one.out, "Each run navigates all the data (no --duration).");
   EXPECT_TRUE(fs::exists(d / "one" / "study.yaml"));
   // Sharded: the study file, jobs in reverse order, then the study's report.
   const Cmd prep = shell(

@@ -50,12 +50,13 @@ std::ptrdiff_t rate_bin_index(const ImuSample& s, double static_end, double bin_
   return k >= 0.0 && k < 1e8 ? static_cast<std::ptrdiff_t>(k) : -1;
 }
 
-/// Room for the bins up to `expected_end`.
+/// Room for the bins up to `expected_end`, at most 2^18 of them (a hint: the series grows
+/// with the data; a time span alone never sizes memory).
 template <class Bin>
-void reserve_bins(std::vector<Bin>& bins, double static_end, double expected_end, double bin_s) {
+void reserve_bins(BinSeries<Bin>& bins, double static_end, double expected_end, double bin_s) {
   const double span = expected_end - static_end;
   if (std::isfinite(span) && span > 0.0 && bin_s > 0.0)
-    bins.reserve(static_cast<std::size_t>(std::min(span / bin_s, 1e8)) + 2);
+    bins.reserve(static_cast<std::size_t>(std::min(span / bin_s, 262144.0)) + 2);
 }
 
 }  // namespace
@@ -83,17 +84,14 @@ void WheelImuCalibrator::add(const ImuSample& s) {
   if (s.dt <= kMaxGap) {
     const std::ptrdiff_t j = rate_bin_index(s, static_.end, opt_.yaw_bin_s);
     if (j >= 0) {  // the series of estimate_body_yaw()
-      const auto i = static_cast<std::size_t>(j);
-      if (i >= axle_bins_.size()) axle_bins_.resize(i + 1);
-      axle_bins_[i].dt += s.dt;
-      axle_bins_[i].f += f * s.dt;
+      AxleBin& a = axle_bins_.at(static_cast<std::size_t>(j));
+      a.dt += s.dt;
+      a.f += f * s.dt;
     }
     // The rate series (RateBin::yaw_rate()).
     const std::ptrdiff_t k = rate_bin_index(s, static_.end, opt_.rate_bin_s);
     if (k >= 0) {
-      const auto i = static_cast<std::size_t>(k);
-      if (i >= bins_.size()) bins_.resize(i + 1);
-      RateBin& b = bins_[i];
+      RateBin& b = bins_.at(static_cast<std::size_t>(k));
       b.dt += s.dt;
       b.spin += -module_.axle_sign * wx * s.dt;
       b.wf += (w.y() * f.y() + w.z() * f.z()) * s.dt;
@@ -276,9 +274,7 @@ void BodyImuCalibrator::add(const ImuSample& s) {
   const Vec3 w = C_BtoV_ * (s.dtheta / s.dt - bias);
   const std::ptrdiff_t k = rate_bin_index(s, static_.end, opt_.yaw_bin_s);
   if (k >= 0) {  // the series of estimate_body_yaw()
-    const auto i = static_cast<std::size_t>(k);
-    if (i >= bins_.size()) bins_.resize(i + 1);
-    BodyBin& b = bins_[i];
+    BodyBin& b = bins_.at(static_cast<std::size_t>(k));
     b.dt += s.dt;
     b.w += w * s.dt;
     b.f += C_BtoV_ * s.dvel;
@@ -363,8 +359,8 @@ void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const Wh
   const double bin_s = opt.yaw_bin_s;
   if (wheels.empty() || wheel_results.size() != wheels.size() || !(bin_s > 0.0) || !(opt.chunk_s > 0.0))
     return finish();
-  std::size_t n = body.bins().size();
-  for (const auto* w : wheels) n = std::min(n, w->axle_bins().size());
+  std::size_t n = body.bins().end_index();
+  for (const auto* w : wheels) n = std::min(n, w->axle_bins().end_index());
   if (n < 3) return finish();
 
   // Each Wheel-IMU's axle, the estimated one, as a row in its manifest b-frame, signed to
@@ -379,27 +375,30 @@ void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const Wh
   }
   const Vec3 dp = body.module().p_inV - p_wheels;  // the manifest's offset
 
-  // Per bin: the Body-IMU's yaw rate and specific force (tilt-corrected v-frame), the
-  // wheels' mean axle specific force.
+  // Per full bin (every module sampled over 90 % of it), in index order: the Body-IMU's yaw
+  // rate and specific force (tilt-corrected v-frame), the wheels' mean axle specific force.
   struct Bin {
-    bool ok = false;
+    std::size_t k = 0;
     double yaw_rate = 0.0, f_x = 0.0, f_y = 0.0, f_axle = 0.0;
   };
-  std::vector<Bin> bins(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const BodyBin& b = body.bins()[k];
+  std::vector<Bin> bins;
+  for (const auto& e : body.bins().entries()) {
+    if (e.index >= n) break;
+    const BodyBin& b = e.bin;
     if (b.dt < 0.9 * bin_s) continue;  // a gap, or the last bin
-    Bin& x = bins[k];
-    x.ok = true;
+    Bin x;
+    x.k = e.index;
     x.yaw_rate = (R_tilt * b.w).z() / b.dt;
     const Vec3 f = R_tilt * b.f / b.dt;
     x.f_x = f.x();
     x.f_y = f.y();
-    for (std::size_t i = 0; i < wheels.size(); ++i) {
-      const AxleBin& wb = wheels[i]->axle_bins()[k];
-      if (wb.dt < 0.9 * bin_s) x.ok = false;
-      else x.f_axle += axle[i].dot(wb.f) / wb.dt / static_cast<double>(wheels.size());
+    bool ok = true;
+    for (std::size_t i = 0; i < wheels.size() && ok; ++i) {
+      const AxleBin* wb = wheels[i]->axle_bins().find(e.index);
+      ok = wb && wb->dt >= 0.9 * bin_s;
+      if (ok) x.f_axle += axle[i].dot(wb->f) / wb->dt / static_cast<double>(wheels.size());
     }
+    if (ok) bins.push_back(x);
   }
 
   // Least squares with an intercept per chunk: the sums of each chunk, centred.
@@ -411,10 +410,12 @@ void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const Wh
     Vec3 XY() const { return xy - x * y / n; }
     double YY() const { return yy - y * y / n; }
   };
-  std::vector<Chunk> chunks;
-  for (std::size_t k = 1; k + 1 < n; ++k) {
-    const Bin &b0 = bins[k - 1], &b = bins[k], &b1 = bins[k + 1];
-    if (!b0.ok || !b.ok || !b1.ok) continue;
+  std::vector<Chunk> chunks;  // those with bins, in time order
+  std::size_t last_chunk = 0;
+  for (std::size_t j = 1; j + 1 < bins.size(); ++j) {
+    const Bin &b0 = bins[j - 1], &b = bins[j], &b1 = bins[j + 1];
+    if (b0.k + 1 != b.k || b.k + 1 != b1.k) continue;  // three consecutive full bins
+    const std::size_t k = b.k;
     const double yaw_acc = (b1.yaw_rate - b0.yaw_rate) / (2.0 * bin_s);
     const double w2 = b.yaw_rate * b.yaw_rate;
     // The lateral specific force the Body-IMU reads beyond the wheels' axles: with the
@@ -422,8 +423,9 @@ void estimate_body_yaw(const BodyImuCalibrator& body, const std::vector<const Wh
     const double y = b.f_y - b.f_axle - (yaw_acc * dp.x() - w2 * dp.y());
     const Vec3 x(b.f_x, yaw_acc, -w2);
     const auto c = static_cast<std::size_t>(std::floor(static_cast<double>(k) * bin_s / opt.chunk_s));
-    if (c >= chunks.size()) chunks.resize(c + 1);
-    Chunk& ch = chunks[c];
+    if (chunks.empty() || c != last_chunk) chunks.emplace_back();
+    last_chunk = c;
+    Chunk& ch = chunks.back();
     ch.n += 1.0;
     ch.y += y;
     ch.yy += y * y;
@@ -489,8 +491,15 @@ void estimate_relative_radius(const std::vector<const WheelImuCalibrator*>& cals
     side[i] = cals[i]->module().p_inV.y() < mid ? 0 : 1;  // 0: left (v-frame y is right)
     y_side[side[i]] += cals[i]->module().p_inV.y();
     ++n_side[side[i]];
-    bins = std::min(bins, cals[i]->rate_bins().size());
+    bins = std::min(bins, cals[i]->rate_bins().end_index());
   }
+  // The bins any module has data in (below the shortest series' end), in order.
+  std::vector<std::size_t> indices;
+  for (const auto* c : cals)
+    for (const auto& e : c->rate_bins().entries())
+      if (e.index < bins) indices.push_back(e.index);
+  std::sort(indices.begin(), indices.end());
+  indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
   y_side[0] /= n_side[0];
   y_side[1] /= n_side[1];
 
@@ -506,16 +515,16 @@ void estimate_relative_radius(const std::vector<const WheelImuCalibrator*>& cals
   std::vector<Fit> fit(n_mod);
   std::vector<double> v(n_mod);
   std::vector<char> ok(n_mod);
-  for (std::size_t k = 0; k < bins; ++k) {
+  for (const std::size_t k : indices) {
     double v_side[2] = {0, 0}, yaw = 0;
     int m[2] = {0, 0};
     for (std::size_t i = 0; i < n_mod; ++i) {
-      const RateBin& b = cals[i]->rate_bins()[k];
+      const RateBin* b = cals[i]->rate_bins().find(k);
       ok[i] = 0;
-      if (b.dt < 0.9 * opt.rate_bin_s) continue;  // a gap, or the last bin
-      const double rate = b.yaw_rate(cals[i]->gravity());
+      if (!b || b->dt < 0.9 * opt.rate_bin_s) continue;  // a gap, or the last bin
+      const double rate = b->yaw_rate(cals[i]->gravity());
       if (!std::isfinite(rate)) continue;  // too slow for a yaw rate
-      v[i] = cals[i]->module().wheel_radius * b.spin / b.dt;
+      v[i] = cals[i]->module().wheel_radius * b->spin / b->dt;
       v_side[side[i]] += v[i];
       yaw += rate;
       ++m[side[i]];

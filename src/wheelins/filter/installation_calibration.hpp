@@ -93,6 +93,45 @@ struct WheelImuCalibration {
   Vec3 lever_arm_inB() const { return {lever_arm[0].value, lever_arm[1].value, lever_arm[2].value}; }
 };
 
+/// The time bins that hold data, in index order (bin k: [k, k + 1) bin widths from the end
+/// of the static period). Only bins with samples are kept, so the memory is in proportion
+/// to the data whatever its time span: a clock in the wrong unit, or a gap of years, costs
+/// one bin per bin of data, never the bins between.
+template <class Bin>
+class BinSeries {
+ public:
+  struct Entry {
+    std::size_t index = 0;
+    Bin bin{};
+  };
+  /// The bin of `index`, added if new (appended when samples come in time order).
+  Bin& at(std::size_t index) {
+    if (entries_.empty() || entries_.back().index < index) {
+      entries_.push_back(Entry{index, Bin{}});
+      return entries_.back().bin;
+    }
+    auto it = lower(index);
+    if (it == entries_.end() || it->index != index) it = entries_.insert(it, Entry{index, Bin{}});
+    return it->bin;
+  }
+  /// The bin of `index`; null when it holds no data.
+  const Bin* find(std::size_t index) const {
+    const auto it = const_cast<BinSeries*>(this)->lower(index);
+    return it == entries_.end() || it->index != index ? nullptr : &it->bin;
+  }
+  const std::vector<Entry>& entries() const { return entries_; }
+  /// One past the last bin's index (0 when empty).
+  std::size_t end_index() const { return entries_.empty() ? 0 : entries_.back().index + 1; }
+  void reserve(std::size_t n) { entries_.reserve(n); }
+
+ private:
+  typename std::vector<Entry>::iterator lower(std::size_t index) {
+    return std::lower_bound(entries_.begin(), entries_.end(), index,
+                            [](const Entry& e, std::size_t k) { return e.index < k; });
+  }
+  std::vector<Entry> entries_;
+};
+
 /// Sums over one time bin of a Wheel-IMU's data (bins from the end of the static period).
 struct RateBin {
   double dt = 0.0;    ///< sampled time in the bin [s]
@@ -160,8 +199,8 @@ class WheelImuCalibrator {
 
   int turns() const { return turns_; }
   const ImuModule& module() const { return module_; }
-  const std::vector<RateBin>& rate_bins() const { return bins_; }
-  const std::vector<AxleBin>& axle_bins() const { return axle_bins_; }
+  const BinSeries<RateBin>& rate_bins() const { return bins_; }
+  const BinSeries<AxleBin>& axle_bins() const { return axle_bins_; }
   /// |f| over the static period (gravity as this accelerometer reads it) [m/s^2].
   double gravity() const { return static_.gravity(); }
 
@@ -210,8 +249,8 @@ class WheelImuCalibrator {
   double spin_angle_ = 0.0, rolling_time_ = 0.0;
   // Relative radius: the rate series.
   double wheel_angle_ = 0.0;
-  std::vector<RateBin> bins_;
-  std::vector<AxleBin> axle_bins_;  // a Body-IMU's yaw fit
+  BinSeries<RateBin> bins_;
+  BinSeries<AxleBin> axle_bins_;  // a Body-IMU's yaw fit
 };
 
 /// Sums over one time bin of a Body-IMU's data (the bins of AxleBin), in the v-frame given
@@ -259,7 +298,7 @@ class BodyImuCalibrator {
   /// Roll and pitch; the yaw is the manifest's until estimate_body_yaw() sets it.
   BodyImuCalibration result() const;
   const ImuModule& module() const { return module_; }
-  const std::vector<BodyBin>& bins() const { return bins_; }
+  const BinSeries<BodyBin>& bins() const { return bins_; }
 
  private:
   void close_chunk();
@@ -273,7 +312,7 @@ class BodyImuCalibrator {
   double turn_time_ = 0.0, turn_chunk_time_ = 0.0, yaw_sum_ = 0.0;
   Vec3 axis_sum_ = Vec3::Zero(), axis_sq_ = Vec3::Zero();
   int axis_chunks_ = 0;
-  std::vector<BodyBin> bins_;
+  BinSeries<BodyBin> bins_;
 };
 
 /// The Body-IMU's mounting yaw (docs/filter.md section 15), from the specific force (gravity

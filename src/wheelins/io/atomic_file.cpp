@@ -30,6 +30,46 @@ void check_output_target(const std::filesystem::path& file, bool overwrite) {
                      "e.g. --force, or choose another name)");
 }
 
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return !ca.empty() && ca == cb;
+}
+
+std::vector<NamedFile> named_files(const std::vector<std::filesystem::path>& files, const std::string& name) {
+  std::vector<NamedFile> out;
+  for (const auto& f : files) out.push_back({f, name});
+  return out;
+}
+
+void check_output_files(const std::vector<OutputFile>& outputs, const std::vector<NamedFile>& inputs,
+                        bool overwrite) {
+  auto named = [](const NamedFile& o) { return (o.name.empty() ? "" : o.name + " ") + quote(o.file); };
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const OutputFile& o = outputs[i];
+    if (o.file.empty())
+      throw InputError((o.name.empty() ? std::string("an output file") : o.name) + ": an empty file name");
+    for (const auto& in : inputs)
+      if (same_file(o.file, in.file))
+        throw InputError(named(o) + ": is " + (in.name.empty() ? quote(in.file) : named(in)) +
+                         ", an input of this command; an output never replaces an input, with or without --force "
+                         "(choose another file)");
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_file(o.file, outputs[j].file))
+        throw InputError(named(o) + ": the same file as " + named(outputs[j]) + "; give each output its own file");
+    std::error_code ec;
+    const auto st = std::filesystem::status(o.file, ec);
+    if (std::filesystem::is_directory(st))
+      throw InputError(named(o) + ": is a directory, expected an output file name");
+    if (std::filesystem::exists(st) && !overwrite)
+      throw InputError(named(o) + ": already exists; refusing to overwrite it (--force replaces it, or choose "
+                       "another name)");
+  }
+}
+
 namespace {
 
 constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,

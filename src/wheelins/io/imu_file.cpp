@@ -77,6 +77,14 @@ bool ImuFileReader::next(ImuSample& out) {
                          (dt == 0.0 ? " repeats the previous record's time"
                                     : " goes back from the previous record's " + format_double(prev_t_)) +
                          " (timestamps must be strictly increasing)");
+    // A time scale that is absurd: no recording pauses for more than a day. Such a jump is
+    // times in another unit (milliseconds) or two recordings joined, and everything after it
+    // (calibration bins, outages, positions) would be nonsense: said here, at its record.
+    if (dt > kMaxImuInterval)
+      rows_->fail(0, "time " + format_double(row_.t) + " is " + format_double(dt) +
+                         " s after the previous record's " + format_double(prev_t_) +
+                         ": more than a day (are the times in another unit than seconds, e.g. "
+                         "milliseconds, or are two recordings joined?)");
     const double nominal = 1.0 / options_.rate_hz;
     if (dt > options_.gap_factor * nominal) {
       DataGap g{index_, prev_t_ + options_.time_offset, row_.t + options_.time_offset};

@@ -36,6 +36,9 @@ struct ImuRow {
 /// Column names of the 7-column layout, for messages and text headers.
 extern const char* const kImuColumnNames[7];
 
+/// [s] the longest interval between two records of one IMU file (a day); longer is an error.
+constexpr double kMaxImuInterval = 86400.0;
+
 struct ImuReadOptions {
   SampleFormat format = SampleFormat::kRate;
   FileLayout layout = FileLayout::kBinary;

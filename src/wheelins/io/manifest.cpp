@@ -15,6 +15,8 @@
 #include <sstream>
 #include <system_error>
 
+#include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/table_import.hpp"
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
@@ -279,11 +281,21 @@ Manifest Loader::load() {
     const std::string path = YamlReader::index_path("modules", i);
     const YAML::Node entry = mods[i];
     m.modules.push_back(module(entry, path));
-    for (std::size_t j = 0; j < i; ++j)
+    for (std::size_t j = 0; j < i; ++j) {
       if (m.modules[j].name == m.modules[i].name)
         fail(join(path, "name"), "duplicate module name '" + m.modules[i].name +
                                      "' (also modules[" + std::to_string(j) + "])",
              &entry);
+      // (A recording that is not there is an error of its own when read; a manifest of
+      // pushed samples, the Python Navigator's, names the same placeholder for every module.)
+      std::error_code ec;
+      const fs::path fi = m.resolve(m.modules[i].file), fj = m.resolve(m.modules[j].file);
+      if (fs::exists(fi, ec) && fs::exists(fj, ec) && same_file(fi, fj))
+        fail(join(path, "file"), "module '" + m.modules[i].name + "' reads the same file as module '" +
+                                     m.modules[j].name + "' (modules[" + std::to_string(j) +
+                                     "]); each module is one IMU's own recording",
+             &entry);
+    }
   }
   return m;
 }
@@ -293,6 +305,17 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
   check_keys(n, path, kModuleKeys);
   ModuleSpec s;
   s.name = text(required(n, path, "name"), join(path, "name"));
+  // A module's name names its output files (NAME.csv in a run's directory): checked here,
+  // where the manifest is read, not when a file cannot be written after the run.
+  try {
+    check_module_name(s.name);
+  } catch (const InputError& e) {
+    fail(join(path, "name"), e.what(), &n);
+  }
+  for (const char* reserved : kReservedModuleNames)
+    if (s.name == reserved)
+      fail(join(path, "name"), "'" + s.name + "' is the name of a run's own output (" + s.name +
+                                   ".csv); choose another module name", &n);
   s.kind = choice<ModuleKind>(required(n, path, "kind"), join(path, "kind"),
                               {{"wheel", ModuleKind::kWheel}, {"body", ModuleKind::kBody}});
   s.group = s.name;
@@ -320,9 +343,11 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
       range(x[static_cast<int>(i)], -lim, lim, index_path(p, i), v, "m");
     return x;
   };
-  if (auto v = get(n, "position_v_m"); v.IsDefined()) s.p_inV = vec_in(v, join(path, "position_v_m"), 20.0);
+  if (auto v = get(n, "position_v_m"); v.IsDefined())
+    s.p_inV = vec_in(v, join(path, "position_v_m"), ManifestLimits::kPositionM);
   if (auto v = get(n, "lever_arm_b_m"); v.IsDefined())
-    s.lever_arm_inB = vec_in(v, join(path, "lever_arm_b_m"), s.kind == ModuleKind::kWheel ? 1.0 : 20.0);
+    s.lever_arm_inB = vec_in(v, join(path, "lever_arm_b_m"),
+                             s.kind == ModuleKind::kWheel ? ManifestLimits::kWheelLeverArmM : ManifestLimits::kBodyLeverArmM);
   if (auto v = get(n, "mounting_deg"); v.IsDefined()) {
     const std::string p = join(path, "mounting_deg");
     const Vec3 deg = vec3(v, p);
@@ -363,13 +388,15 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
   }
   if (auto v = get(n, "gyro_range_dps"); v.IsDefined()) {
     const std::string p = join(path, "gyro_range_dps");
-    range(number(v, p), 10.0, 1e5, p, v, "deg/s (the gyro's full scale)");
+    range(number(v, p), ManifestLimits::kGyroRangeMinDps, ManifestLimits::kGyroRangeMaxDps, p, v,
+          "deg/s (the gyro's full scale)");
     s.gyro_range = number(v, p, kDegU);
   }
   if (auto v = get(n, "accel_range_m_s2"); v.IsDefined()) {
     const std::string p = join(path, "accel_range_m_s2");
     s.accel_range = number(v, p);
-    range(s.accel_range, 5.0, 1e5, p, v, "m/s^2 (the accelerometer's full scale)");
+    range(s.accel_range, ManifestLimits::kAccelRangeMin, ManifestLimits::kAccelRangeMax, p, v,
+          "m/s^2 (the accelerometer's full scale)");
   }
   // Defaults for what the manifest does not state: ImuNoise's, and a velocity random walk
   // by kind (a rolling wheel vibrates).
@@ -453,6 +480,14 @@ const char* to_string(FileLayout l) { return l == FileLayout::kBinary ? "binary"
 fs::path Manifest::resolve(const fs::path& p) const {
   if (p.is_absolute() || path.empty()) return p;
   return path.parent_path() / p;
+}
+
+std::vector<fs::path> Manifest::input_files() const {
+  std::vector<fs::path> out;
+  for (const auto& m : modules) out.push_back(resolve(m.file));
+  if (truth_file) out.push_back(resolve(*truth_file));
+  if (odometer_file) out.push_back(resolve(*odometer_file));
+  return out;
 }
 
 const ModuleSpec* Manifest::find(const std::string& module_name) const {
@@ -570,6 +605,56 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
     }
   }
   return w.str();
+}
+
+ManifestAnnotations read_manifest_notes(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(quote(file) + ": cannot read");
+  ManifestAnnotations notes;
+  std::vector<std::pair<std::size_t, std::string>> stack;  // (indent, path) of the open keys
+  std::map<std::string, int> items;                         // list items seen per list path
+  bool body = false;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::size_t ind = line.find_first_not_of(' ');
+    if (ind == std::string::npos) continue;
+    if (line[ind] == '#') {
+      if (!body && ind == 0 && line.rfind("# wheelins dataset manifest", 0) != 0)
+        notes.header.push_back(line.size() > 2 ? line.substr(2) : std::string());
+      continue;
+    }
+    body = true;
+    // The comment: a '#' after a blank, outside double quotes.
+    std::string comment;
+    bool quoted = false;
+    for (std::size_t k = ind; k < line.size(); ++k) {
+      if (line[k] == '"' && (k == 0 || line[k - 1] != '\\')) quoted = !quoted;
+      if (!quoted && line[k] == '#' && k > 0 && line[k - 1] == ' ') {
+        comment = line.substr(k + 1);
+        line.resize(k);
+        break;
+      }
+    }
+    comment.erase(0, comment.find_first_not_of(' '));
+    // "- key:" opens an element of the list its parent key holds; its keys sit 2 further in.
+    const bool item = line.compare(ind, 2, "- ") == 0;
+    const std::size_t at = item ? ind + 2 : ind;
+    const std::size_t colon = line.find(':', at);
+    if (colon == std::string::npos) continue;
+    const std::string key = line.substr(at, colon - at);
+    while (!stack.empty() && stack.back().first >= ind) stack.pop_back();
+    std::string parent = stack.empty() ? "" : stack.back().second;
+    if (item) {
+      parent += "[" + std::to_string(items[parent]++) + "]";
+      stack.emplace_back(ind, parent);
+      if (key == "name" && !comment.empty()) notes.comments[parent] = comment;  // as the writer puts it
+    }
+    const std::string path = parent.empty() ? key : parent + "." + key;
+    stack.emplace_back(at, path);
+    if (!comment.empty() && !(item && key == "name")) notes.comments[path] = comment;
+  }
+  return notes;
 }
 
 void save_manifest(const Manifest& m, const fs::path& file) { save_manifest(m, file, {}); }

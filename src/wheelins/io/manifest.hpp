@@ -22,6 +22,19 @@ namespace wheelins {
 enum class SampleFormat { kRate, kIncrement };  ///< rad/s & m/s^2, or rad & m/s per sample
 enum class FileLayout { kBinary, kText };       ///< float64 LE rows, or whitespace/CSV text
 
+/// What a manifest accepts for a module's geometry and sensor ranges (docs/manifest.md):
+/// declared once, read by the manifest loader and by the simulator's settings check, so
+/// `simulate` never writes a dataset that `run` refuses.
+struct ManifestLimits {
+  static constexpr double kPositionM = 20.0;        ///< |position_v_m| per axis [m]
+  static constexpr double kWheelLeverArmM = 1.0;    ///< a wheel's |lever_arm_b_m| per axis [m]
+  static constexpr double kBodyLeverArmM = 20.0;    ///< a body's |lever_arm_b_m| per axis [m]
+  static constexpr double kGyroRangeMinDps = 10.0;  ///< gyro_range_dps [deg/s]
+  static constexpr double kGyroRangeMaxDps = 1e5;
+  static constexpr double kAccelRangeMin = 5.0;     ///< accel_range_m_s2 [m/s^2]
+  static constexpr double kAccelRangeMax = 1e5;
+};
+
 /// One IMU module (one chip's data file): the module as the estimator knows it (name, kind,
 /// rate, geometry, noise: ImuModule, nav/vehicle.hpp) and where and how its data are stored.
 /// Which of ImuNoise's figures a manifest states, one bit per key of its `noise:` map in the
@@ -54,6 +67,9 @@ struct ModuleSpec : ImuModule {
   double odometry_radius = 0.0;
 };
 
+/// Names a module cannot have: a run writes NAME.csv per module beside these files of its own.
+inline constexpr const char* kReservedModuleNames[] = {"trajectory", "faults", "weights"};
+
 struct Manifest {
   std::filesystem::path path;       ///< where it was loaded from (relative files resolve here)
   std::string name;
@@ -79,6 +95,9 @@ struct Manifest {
   /// Absolute path of a file named in the manifest.
   std::filesystem::path resolve(const std::filesystem::path& p) const;
   const ModuleSpec* find(const std::string& module_name) const;
+  /// Every data file the manifest names (the modules' recordings, truth, odometer): inputs
+  /// that no output of a command reading them may replace.
+  std::vector<std::filesystem::path> input_files() const;
   double gravity_or_default() const;
   /// What the navigator is told (vehicle_setup()): a Manifest converts implicitly, so a
   /// Navigator is made straight from one.
@@ -108,6 +127,12 @@ struct ManifestAnnotations {
 };
 void save_manifest(const Manifest& m, const std::filesystem::path& file,
                    const ManifestAnnotations& notes);
+/// The notes of a manifest file as save_manifest writes them: the header comment lines
+/// (but the format line every manifest opens with) and each key's trailing comment, by key
+/// path ("vehicle.track_m", "modules[1].wheel_radius_m"). Comments of keys written in
+/// flow style or on lines of their own are not kept. Throws InputError if unreadable.
+ManifestAnnotations read_manifest_notes(const std::filesystem::path& file);
+
 /// The YAML text save_manifest writes; relative paths are written for a manifest in `dir`.
 std::string manifest_to_yaml(const Manifest& m, const std::filesystem::path& dir,
                              const ManifestAnnotations& notes = {});

@@ -13,6 +13,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <optional>
+#include <set>
 #include <system_error>
 
 #include "wheelins/io/text_util.hpp"
@@ -95,6 +97,21 @@ std::string with_article(const std::string& kind) {
   return (kind == "experiment" ? "an " : "a ") + kind;
 }
 
+/// The entries a marker lists as written by wheelins ("file NAME" lines), or nothing if the
+/// marker predates the list.
+std::optional<std::set<std::string>> written_entries(const fs::path& dir) {
+  std::ifstream in(dir / kOutputMarker);
+  std::string line;
+  std::set<std::string> names;
+  bool listed = false;
+  while (std::getline(in, line)) {
+    if (line == "files:") listed = true;
+    else if (listed && line.rfind("- ", 0) == 0) names.insert(line.substr(2));
+  }
+  if (!listed) return std::nullopt;
+  return names;
+}
+
 std::string first_entry(const fs::path& dir) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) return e.path().filename().string();
@@ -120,6 +137,15 @@ OutputDir::OutputDir(const fs::path& target, const OutputDirOptions& options) : 
   target_ = fs::absolute(target).lexically_normal();
   if (target_.filename().empty()) target_ = target_.parent_path();
   const std::string q = quote(target);
+  std::error_code lec;
+  if (fs::is_symlink(fs::symlink_status(target_, lec))) {
+    // Followed: the output goes where the link points, and the link stays a link.
+    const fs::path to = fs::canonical(target_, lec);
+    if (lec)
+      throw InputError(q + ": a symbolic link to " + quote(fs::read_symlink(target_, lec)) +
+                       ", which does not exist (create that directory, or give another output directory)");
+    target_ = to;
+  }
   const fs::path parent = target_.parent_path();
   const std::string name = target_.filename().string();
 
@@ -192,13 +218,44 @@ void OutputDir::cleanup() noexcept {
 
 OutputDir::~OutputDir() { cleanup(); }
 
+void OutputDir::replace_target(const std::string& q) {
+#ifdef RENAME_EXCHANGE
+  const bool exchanged =
+      ::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0;
+#else
+  const bool exchanged = false;
+#endif
+  std::error_code ec;
+  if (exchanged) {
+    fs::remove_all(staging_, ec);  // now the earlier output
+    return;
+  }
+  // No atomic exchange on this file system: the old output steps aside first.
+  const fs::path old =
+      target_.parent_path() / ("." + target_.filename().string() + ".old-" + std::to_string(::getpid()));
+  if (::rename(target_.c_str(), old.c_str()) != 0)
+    throw InputError(q + ": cannot move the finished " + opt_.kind + " into place: " + std::strerror(errno));
+  if (::rename(staging_.c_str(), target_.c_str()) != 0) {
+    const int err = errno;
+    ::rename(old.c_str(), target_.c_str());
+    throw InputError(q + ": cannot move the finished " + opt_.kind + " into place: " + std::strerror(err));
+  }
+  fs::remove_all(old, ec);
+}
+
 void OutputDir::commit() {
   if (committed_) return;
   const std::string q = quote(target_);
+  std::error_code ec;
+  std::set<std::string> written;
+  for (const auto& e : fs::directory_iterator(staging_, ec)) written.insert(e.path().filename().string());
   {
     std::FILE* f = std::fopen((staging_ / kOutputMarker).c_str(), "wb");
     if (!f) throw InputError(quote(staging_) + ": cannot write: " + std::strerror(errno));
-    const std::string text = "wheelins " + opt_.kind + "\n";
+    // The first line says what the directory holds; the list, what wheelins wrote there
+    // (all a later --force may replace).
+    std::string text = "wheelins " + opt_.kind + "\nfiles:\n";
+    for (const auto& n : written) text += "- " + n + "\n";
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
     if (std::fclose(f) != 0 || !ok)
       throw InputError(quote(staging_) + ": write failed: " + std::strerror(errno));
@@ -209,24 +266,45 @@ void OutputDir::commit() {
       throw InputError(q + ": cannot move the finished " + opt_.kind + " into place: " +
                        std::strerror(errno) + " (another command wrote there meanwhile?)");
   } else if (kind == opt_.kind && opt_.overwrite) {
-#ifdef RENAME_EXCHANGE
-    const bool exchanged =
-        ::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0;
-#else
-    const bool exchanged = false;
-#endif
-    if (!exchanged) {
-      // No atomic exchange on this file system: the old output steps aside first.
-      const fs::path old = target_.parent_path() /
-                           ("." + target_.filename().string() + ".old-" + std::to_string(::getpid()));
-      if (::rename(target_.c_str(), old.c_str()) != 0 || ::rename(staging_.c_str(), target_.c_str()) != 0)
-        throw InputError(q + ": cannot move the finished " + opt_.kind + " into place: " +
-                         std::strerror(errno));
-      std::error_code ec;
-      fs::remove_all(old, ec);
-    } else {
-      std::error_code ec;
-      fs::remove_all(staging_, ec);  // now the earlier output
+    // What the earlier output holds that wheelins did not write (the marker's list; an
+    // older marker without one: whatever this output does not write again) moves into the
+    // new output, so that replacing it loses nothing of the user's.
+    const auto listed = written_entries(target_);
+    std::vector<std::string> keep;
+    for (const auto& e : fs::directory_iterator(target_, ec)) {
+      const std::string n = e.path().filename().string();
+      if (n == kOutputMarker || (listed ? listed->count(n) > 0 : written.count(n) > 0)) continue;
+      if (written.count(n))
+        throw InputError(q + ": holds '" + n + "', which wheelins did not write there and this " + opt_.kind +
+                         " would replace; move it away first (nothing was changed)");
+      keep.push_back(n);
+    }
+    std::size_t moved = 0;
+    auto put_back = [&] {
+      for (std::size_t i = 0; i < moved; ++i) {
+        std::error_code ec2;
+        fs::rename(staging_ / keep[i], target_ / keep[i], ec2);
+      }
+    };
+    for (; moved < keep.size(); ++moved) {
+      fs::rename(target_ / keep[moved], staging_ / keep[moved], ec);
+      if (ec) {
+        put_back();
+        throw InputError(q + ": cannot keep '" + keep[moved] + "' (not written by wheelins): " + ec.message() +
+                         "; nothing was replaced");
+      }
+    }
+    try {
+      replace_target(q);
+    } catch (...) {
+      put_back();
+      throw;
+    }
+    kept_ = keep;
+    if (opt_.notice && !keep.empty()) {
+      std::string list;
+      for (const auto& n : keep) list += (list.empty() ? "'" : ", '") + n + "'";
+      opt_.notice(q + ": replaced the earlier " + opt_.kind + " and kept what wheelins did not write there: " + list);
     }
   } else if (kind == opt_.kind) {
     throw InputError(q + ": another command wrote " + opt_.kind + " there meanwhile; refusing to "

@@ -7,15 +7,20 @@
 // earlier output when replacing one). A killed writer leaves only its staging directory,
 // which the next writer to the same target removes; a reader never sees a mixed set.
 //
-// The target is owned as a whole: it must be absent, empty, or an earlier output of the
-// same kind (marked by the file `.wheelins`), and an earlier output is replaced only with
-// `overwrite`. A directory holding anything else (the user's files, a dataset when results
-// are written, an input of the command) is refused, with or without `overwrite`. While
-// the work runs the target is locked (flock): a second writer fails at once with a clear
-// error instead of writing over the first one's files.
+// The target must be absent, empty, or an earlier output of the same kind (marked by the
+// file `.wheelins`, which lists the files wheelins wrote there), and an earlier output is
+// replaced only with `overwrite`. Replacing replaces only what wheelins wrote: anything the
+// user added since (notes, a run's results inside a dataset) is moved into the new output
+// and named (`notice`); a file the new output would write under the same name is refused.
+// A directory holding anything else (the user's files, a dataset when results are written,
+// an input of the command) is refused, with or without `overwrite`. A symbolic link is
+// followed: the output goes into the directory it points to and the link stays. While the
+// work runs the target is locked (flock): a second writer fails at once with a clear error
+// instead of writing over the first one's files.
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,6 +34,8 @@ struct OutputDirOptions {
   std::string overwrite_hint = "--force";
   /// Files the command reads: a target that holds one of them is never replaced.
   std::vector<std::filesystem::path> inputs;
+  /// Told which entries of an earlier output were kept because wheelins did not write them.
+  std::function<void(const std::string&)> notice;
 };
 
 /// The marker file of a directory written through OutputDir.
@@ -52,15 +59,21 @@ class OutputDir {
   /// Writes the marker and moves the staging directory into place.
   void commit();
   bool committed() const { return committed_; }
+  /// The entries of the earlier output that commit() kept (not written by wheelins).
+  const std::vector<std::string>& kept() const { return kept_; }
 
  private:
   void cleanup() noexcept;
+  /// Moves the staging directory onto the earlier output (an atomic exchange where the file
+  /// system has one) and removes the earlier output.
+  void replace_target(const std::string& quoted);
   std::filesystem::path target_, staging_;
   OutputDirOptions opt_;
   int lock_fd_ = -1;
   bool created_target_ = false;
   bool replace_ = false;
   bool committed_ = false;
+  std::vector<std::string> kept_;
 };
 
 /// "what kind of output `dir` holds": "" if absent or empty, the marker's kind, or

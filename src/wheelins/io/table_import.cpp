@@ -33,23 +33,11 @@ bool module_char(char c) {
 
 std::string output_name(const std::string& module) { return module + "_imu.bin"; }
 
-/// Removes the temporaries (`NAME.partial-PID-N`) of `names` in `dir` left by writers that
-/// are gone (killed): the next import cleans up after them.
-void sweep_stale_partials(const fs::path& dir, const std::vector<std::string>& names) {
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string n = e.path().filename().string();
-    for (const auto& name : names) {
-      const std::string prefix = name + ".partial-";
-      if (n.rfind(prefix, 0) != 0) continue;
-      const long pid = std::strtol(n.c_str() + prefix.size(), nullptr, 10);
-      const bool alive = pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
-      if (!alive) {
-        std::error_code rm;
-        fs::remove(e.path(), rm);
-      }
-    }
-  }
+/// A bad name made printable in a message about the files it would name.
+std::string name_for_files(const std::string& name) {
+  std::string out;
+  for (char c : name) out += module_char(c) ? c : '_';
+  return out;
 }
 
 }  // namespace
@@ -61,8 +49,9 @@ void check_module_name(const std::string& name) {
     throw InputError(q + ": longer than " + std::to_string(kMaxModuleName) + " characters");
   for (char c : name)
     if (!module_char(c))
-      throw InputError(q + ": only letters, digits, '_', '.' and '-' may be used (no path separators or "
-                           "blanks); it names the file " + output_name(name));
+      throw InputError(q + ": only letters, digits, '_', '.' and '-' may be used (no path separators, "
+                           "commas or blanks); it names files such as " + name_for_files(name) + ".csv and " +
+                           output_name(name_for_files(name)));
   if (name.front() == '.') throw InputError(q + ": must not start with '.' (a hidden file)");
   if (name.find("..") != std::string::npos) throw InputError(q + ": must not contain '..'");
 }
@@ -115,7 +104,8 @@ std::vector<ImportedTable> import_tables(const std::vector<TableInput>& inputs, 
   const bool created = !fs::exists(out_dir, ec);
   fs::create_directories(out_dir, ec);
   if (ec) throw InputError(quote(out_dir) + ": cannot create: " + ec.message());
-  sweep_stale_partials(out_dir, names);
+  for (const auto& n : io_detail::sweep_stale_partials(out_dir, names))
+    if (options.warn) options.warn(quote(out_dir / n) + ": removed, the temporary file of an import that was killed");
 
   std::uint64_t total = 0, done = 0;
   if (options.progress)

@@ -1,6 +1,7 @@
 // Exact number formatting and strict parsing (text_util.hpp), and the text helpers of io.
 #include "wheelins/io/text_util.hpp"
 
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <iostream>
@@ -57,6 +59,30 @@ std::filesystem::path unique_partial(const std::filesystem::path& file) {
   return file.string() + ".partial-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
 }
 
+std::vector<std::string> sweep_stale_partials(const std::filesystem::path& dir,
+                                              const std::vector<std::string>& names) {
+  std::vector<std::string> removed;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string n = e.path().filename().string();
+    const std::size_t at = n.rfind(".partial-");
+    if (at == std::string::npos || at == 0) continue;
+    if (!names.empty() && std::find(names.begin(), names.end(), n.substr(0, at)) == names.end()) continue;
+    // NAME.partial-PID-N: digits, a dash, digits, nothing else.
+    const char* p = n.c_str() + at + 9;
+    char* end = nullptr;
+    const long pid = std::strtol(p, &end, 10);
+    if (end == p || *end != '-' || !std::isdigit(static_cast<unsigned char>(end[1]))) continue;
+    const char* q = end + 1;
+    while (std::isdigit(static_cast<unsigned char>(*q))) ++q;
+    if (*q != '\0' || pid <= 0) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM) continue;  // its writer is running
+    std::error_code rm;
+    if (e.is_regular_file(rm) && std::filesystem::remove(e.path(), rm)) removed.push_back(n);
+  }
+  return removed;
+}
+
 bool bounded_getline(std::istream& in, std::string& line, std::size_t max_len,
                      const std::string& where) {
   line.resize(max_len + 1);
@@ -75,6 +101,11 @@ bool bounded_getline(std::istream& in, std::string& line, std::size_t max_len,
                      " characters: not a text file of this kind (binary data, or a device?)");
   }
   line.resize(in.eof() ? n : n - 1);  // gcount counts the extracted newline
+  // A mark on the first line: the stream is now just past this line (a stream without a
+  // position, a pipe, keeps its mark).
+  if (line.compare(0, 3, "\xEF\xBB\xBF") == 0 && in.rdbuf() &&
+      in.rdbuf()->pubseekoff(0, std::ios::cur, std::ios::in) == std::streampos(static_cast<std::streamoff>(n)))
+    line.erase(0, 3);
   return true;
 }
 

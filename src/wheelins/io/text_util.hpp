@@ -45,17 +45,30 @@ constexpr std::size_t kMaxTextLine = 1 << 16;
 constexpr std::uint64_t kMaxYamlBytes = 4u << 20;
 /// The deepest nesting of YAML collections accepted.
 constexpr int kMaxYamlDepth = 32;
+/// The most nodes that aliases (`*name`) of one YAML text may add by repeating what their
+/// anchor (`&name`) stands for: a configuration repeats a block a few times; nested
+/// aliases ("billion laughs") would make a walk of the tree take hours.
+constexpr std::uint64_t kMaxYamlAliasNodes = 100000;
 /// Warnings of one kind (unknown keys) printed per file; the rest are counted.
 constexpr int kMaxKeyWarnings = 20;
 
 /// std::getline with a bound: false at the end of the stream; a line longer than `max_len`
 /// throws InputError "<where>: line longer than N characters: not a text file of this kind".
+/// Every text reader reads its lines here, so this is where a UTF-8 byte-order mark (which
+/// editors write at the start of a file, and which no error message would show) is dropped:
+/// at the start of the stream's first line, the only place one belongs.
 bool bounded_getline(std::istream& in, std::string& line, std::size_t max_len,
                      const std::string& where);
 
 /// A temporary name beside `file` for writing it, unique to this process and call
 /// (`file.partial-PID-N`): two writers of one file never share (and truncate) a temporary.
 std::filesystem::path unique_partial(const std::filesystem::path& file);
+/// Removes the temporaries of unique_partial() in `dir` (`NAME.partial-PID-N`) whose writer
+/// (PID) is gone, e.g. a killed import: they are wheelins' own, never the user's. With
+/// `names`, only those of these file names. Returns the names removed, for the caller to
+/// say so.
+std::vector<std::string> sweep_stale_partials(const std::filesystem::path& dir,
+                                              const std::vector<std::string>& names = {});
 
 /// The fields of a line separated by `sep`; ' ' means runs of blanks (spaces, tabs, CRs),
 /// where empty fields do not arise. Views into `line`.

@@ -2,6 +2,8 @@
 // closest known key, and errors naming the file, key path and line.
 #include "wheelins/io/yaml_reader.hpp"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -101,7 +103,114 @@ int tree_depth(const YAML::Node& n, int limit, int depth = 1) {
   return deepest;
 }
 
+/// Follows the parser's events and counts the nodes the tree has once every alias stands
+/// for its anchor's node, before the tree is built: yaml-cpp shares an aliased node instead
+/// of copying it, so nested aliases cost nothing to parse but a walk of the tree (every
+/// reader's) visits each repetition. Throws InputError at the alias that passes
+/// kMaxYamlAliasNodes, or that refers to a node it is inside (a cycle).
+class AliasBudget : public YAML::EventHandler {
+ public:
+  AliasBudget(std::string where, std::string kind) : where_(std::move(where)), kind_(std::move(kind)) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t anchor) override { leaf(anchor); }
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, const std::string&) override {
+    leaf(anchor);
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    const std::string at = "line " + std::to_string(mark.line + 1) + ": ";
+    if (anchor >= size_.size() || open_[anchor])
+      throw InputError(where_ + ": " + at + "an alias (*name) inside the node it refers to (a cycle); a " +
+                       kind_ + " cannot be infinite");
+    added_ += size_[anchor];
+    if (added_ > io_detail::kMaxYamlAliasNodes)
+      throw InputError(where_ + ": " + at + "aliases (*name) repeat more than " +
+                       std::to_string(io_detail::kMaxYamlAliasNodes) + " values (nested aliases?); write the " +
+                       kind_ + " out or use fewer aliases");
+    add(size_[anchor]);
+  }
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
+    open(anchor);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(anchor);
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  void reserve(YAML::anchor_t anchor) {
+    if (anchor >= size_.size()) {
+      size_.resize(anchor + 1, 0);
+      open_.resize(anchor + 1, false);
+    }
+  }
+  void add(std::uint64_t n) {
+    if (!stack_.empty()) stack_.back().second += n;
+  }
+  void leaf(YAML::anchor_t anchor) {
+    reserve(anchor);
+    if (anchor) size_[anchor] = 1;
+    add(1);
+  }
+  void open(YAML::anchor_t anchor) {
+    reserve(anchor);
+    if (anchor) open_[anchor] = true;
+    stack_.emplace_back(anchor, 1);
+  }
+  void close() {
+    if (stack_.empty()) return;
+    const auto [anchor, n] = stack_.back();
+    stack_.pop_back();
+    if (anchor) {
+      size_[anchor] = n;
+      open_[anchor] = false;
+    }
+    add(n);
+  }
+
+  std::string where_, kind_;
+  std::vector<std::uint64_t> size_;  ///< nodes under each anchor, aliases expanded
+  std::vector<bool> open_;           ///< an anchor whose collection is still being read
+  std::vector<std::pair<YAML::anchor_t, std::uint64_t>> stack_;
+  std::uint64_t added_ = 0;  ///< nodes the aliases add (each <= the budget, so no overflow)
+};
+
 }  // namespace
+
+YAML::Node parse_yaml(const std::string& text, const std::string& where, const std::string& kind) {
+  if (text.size() > io_detail::kMaxYamlBytes)
+    throw InputError(where + ": " + std::to_string(text.size()) + " bytes; a " + kind + " has at most " +
+                     std::to_string(io_detail::kMaxYamlBytes >> 20) + " MiB (is this the right file?)");
+  if (text.find('\0') != std::string::npos)
+    throw InputError(where + ": contains NUL bytes: a binary file, not a " + kind + " (YAML text)");
+  std::size_t line = flow_depth_violation(text, io_detail::kMaxYamlDepth);
+  if (!line) line = block_depth_violation(text, io_detail::kMaxYamlDepth);
+  if (line)
+    throw InputError(where + ": line " + std::to_string(line) + ": lists or mappings nested deeper than " +
+                     std::to_string(io_detail::kMaxYamlDepth) + " levels; a " + kind + " needs a few");
+  YAML::Node root;
+  try {
+    {
+      std::istringstream in(text);
+      YAML::Parser parser(in);
+      AliasBudget budget(where, kind);
+      parser.HandleNextDocument(budget);
+    }
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    std::string at;
+    if (!e.mark.is_null())
+      at = "line " + std::to_string(e.mark.line + 1) + ", column " + std::to_string(e.mark.column + 1) + ": ";
+    throw InputError(where + ": " + at + "malformed YAML: " + e.msg);
+  }
+  if (tree_depth(root, io_detail::kMaxYamlDepth) > io_detail::kMaxYamlDepth)
+    throw InputError(where + ": lists or mappings nested deeper than " +
+                     std::to_string(io_detail::kMaxYamlDepth) + " levels; a " + kind + " needs a few");
+  return root;
+}
 
 YAML::Node load_yaml_file(const fs::path& file, const std::string& kind,
                           const std::string& directory_hint) {
@@ -122,26 +231,7 @@ YAML::Node load_yaml_file(const fs::path& file, const std::string& kind,
   std::string text(static_cast<std::size_t>(bytes), '\0');
   in.read(text.data(), static_cast<std::streamsize>(bytes));
   text.resize(static_cast<std::size_t>(in.gcount()));
-  if (text.find('\0') != std::string::npos)
-    throw InputError(where + ": contains NUL bytes: a binary file, not a " + kind + " (YAML text)");
-  std::size_t line = flow_depth_violation(text, io_detail::kMaxYamlDepth);
-  if (!line) line = block_depth_violation(text, io_detail::kMaxYamlDepth);
-  if (line)
-    throw InputError(where + ": line " + std::to_string(line) + ": lists or mappings nested deeper than " +
-                     std::to_string(io_detail::kMaxYamlDepth) + " levels; a " + kind + " needs a few");
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    std::string at;
-    if (!e.mark.is_null())
-      at = "line " + std::to_string(e.mark.line + 1) + ", column " + std::to_string(e.mark.column + 1) + ": ";
-    throw InputError(where + ": " + at + "malformed YAML: " + e.msg);
-  }
-  if (tree_depth(root, io_detail::kMaxYamlDepth) > io_detail::kMaxYamlDepth)
-    throw InputError(where + ": lists or mappings nested deeper than " +
-                     std::to_string(io_detail::kMaxYamlDepth) + " levels; a " + kind + " needs a few");
-  return root;
+  return parse_yaml(text, where, kind);
 }
 
 YamlReader::YamlReader(const fs::path& file, WarningSink warn, std::string kind,

@@ -17,9 +17,16 @@
 
 namespace wheelins {
 
-/// Reads and parses a YAML file with the checks every YAML input gets: a regular file
-/// (io_detail::check_input_file), at most io_detail::kMaxYamlBytes, no NUL bytes, nested at
-/// most io_detail::kMaxYamlDepth deep. `kind` names the file in messages.
+/// The one way wheelins parses YAML (files, --set values, a study's settings, its records):
+/// at most io_detail::kMaxYamlBytes, no NUL bytes, nested at most io_detail::kMaxYamlDepth
+/// deep, and aliases (`*name`) that repeat at most io_detail::kMaxYamlAliasNodes values and
+/// never the node they are in, so that no walk of the tree runs away. Every failure is an
+/// InputError starting with `where` (a quoted file name, an option) and naming the line;
+/// `kind` says what the text is ("manifest", "study").
+YAML::Node parse_yaml(const std::string& text, const std::string& where, const std::string& kind);
+
+/// Reads and parses a YAML file with parse_yaml's checks, and first those of every input
+/// file (io_detail::check_input_file: a regular file). `kind` names the file in messages.
 YAML::Node load_yaml_file(const std::filesystem::path& file, const std::string& kind,
                           const std::string& directory_hint = "");
 

@@ -85,9 +85,44 @@ InstallationCalibration calibrate_installation(
     const InstallationCalibrationOptions& opt, bool isolate_faults, bool progress,
     double t_end = std::numeric_limits<double>::infinity());
 
+/// What a calibration did with one value of the manifest. One list of these is what the
+/// console table, calibration.yaml and the refined manifest's notes all say.
+enum class CalibrationOutcome {
+  kEstimated,     ///< the data determine it (1 sigma below half the prior's): the estimate is used
+  kWeak,          ///< the data moved it without determining it: the estimate, drawn towards the manifest's value, is used
+  kKept,          ///< no information in the data: the manifest's value is kept
+  kNotEstimable,  ///< not estimated by design (a Wheel-IMU's roll and lever arm x, a body's height): the manifest's, re-expressed in the calibrated axes
+};
+/// "estimated", "weak", "kept", "not estimable".
+const char* to_string(CalibrationOutcome o);
+
+struct CalibrationDecision {
+  std::string module;
+  std::string key;      ///< the manifest key: mounting_deg, lever_arm_b_m, wheel_radius_m, position_v_m
+  int component = -1;   ///< 0..2 of a vector key, -1 a scalar
+  CalibrationOutcome outcome = CalibrationOutcome::kKept;
+  /// The value only matters to navigation through others (a Wheel-IMU's roll about the axle
+  /// and lever arm along it): never a TODO.
+  bool without_effect = false;
+  bool relative = false;  ///< a wheel radius relative to the other side's (the absolute one is not observable)
+};
+
+/// Every calibrated value of `cal`, module by module, key by key, component by component.
+std::vector<CalibrationDecision> calibration_decisions(const InstallationCalibration& cal);
+
 /// The manifest with each calibrated module's mounting, lever arm and radius replaced by
-/// the estimates (an unobserved part keeps the manifest's value).
+/// what calibration_decisions() says is used: the estimate where estimated or weak (a weak
+/// one is drawn towards the manifest's value by its prior), the manifest's where kept.
 Manifest apply_calibration(Manifest m, const InstallationCalibration& cal);
+
+/// The notes of the refined manifest: `input` (the input manifest's, read_manifest_notes())
+/// with every calibrated key's note saying, from calibration_decisions(), what was
+/// estimated, what was kept and what is still a guess: a key the input marked TODO stays
+/// TODO while any part of it that matters was not estimated; a wheel radius (relative only)
+/// stays TODO unless measured (`reference_measured`: the wheels whose absolute radius a
+/// reference measured).
+ManifestAnnotations calibration_notes(const Manifest& m, const InstallationCalibration& cal, ManifestAnnotations input,
+                                      const std::vector<std::string>& reference_measured = {});
 
 /// calibration.yaml: per module the estimates, their 1 sigma, the manifest values and
 /// whether the data determined them, in the manifest's keys and units.

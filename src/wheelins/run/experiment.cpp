@@ -130,8 +130,10 @@ std::string experiment_markdown(const ExperimentResult& r) {
 
   o << "# Experiment: " << (r.dataset_name.empty() ? r.manifest.string() : r.dataset_name) << "\n\n"
     << "Dataset `" << r.manifest.string() << "`; " << r.runs.size() << " runs in "
-    << fmt(r.wall_seconds, 1) << " s. Drift rate: paper Section VI-B (l = 100 m), in % of "
-    << "distance; heading RMSE in degrees.\n\n";
+    << fmt(r.wall_seconds, 1) << " s. Each run navigates "
+    << (r.duration > 0.0 ? fmt(r.duration, 1) + " s after the static period (--duration)"
+                         : std::string("all the data (no --duration)"))
+    << ". Drift rate: paper Section VI-B (l = 100 m), in % of distance; heading RMSE in degrees.\n\n";
 
   // Table 4
   const auto singles = runs_of("single", false);

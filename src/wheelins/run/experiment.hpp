@@ -48,6 +48,7 @@ struct ExperimentResult {
   std::string dataset_name;
   std::filesystem::path truth_file;  ///< the truth the runs were evaluated against
   earth::Geodetic origin;            ///< the local frame's origin (manifest)
+  double duration = 0.0;             ///< [s] of navigation per run asked for (--duration; 0: all the data)
   std::vector<ExperimentRun> runs;
   double wall_seconds = 0.0;
 };

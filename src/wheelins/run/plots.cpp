@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/math/rotation.hpp"
 #include "wheelins/nav/types.hpp"
 
@@ -318,8 +319,12 @@ void add_trajectory(Output& out, const ExperimentResult& r, const TruthData& tru
                               : run.configuration == "body-wheel" ? 1
                               : run.configuration == "triple"     ? 2
                                                                   : 3;
-    parts.push_back("  " + gq(rel) + " skip 1 using 2:3 with lines lw 1.8 lc rgb " +
-                    gq(kTrackColors[color]) + " title " + gq(run_title(run)));
+    // None may hide another where the tracks lie on top of each other: the first drawn is the
+    // widest, each later one narrower, dashed differently and a little transparent (ARGB).
+    const double lw = std::max(1.2, 4.2 - 0.9 * static_cast<double>(i));
+    const char* dash[] = {"1", "(12,5)", "(4,4)", "(14,4,3,4)"};
+    parts.push_back("  " + gq(rel) + " skip 1 using 2:3 with lines lw " + num(lw) + " dt " + dash[color] +
+                    " lc rgb " + gq("#30" + std::string(kTrackColors[color] + 1)) + " title " + gq(run_title(run)));
   }
   // Equal scale on a 3:2 canvas: the legend goes where the path leaves room.
   const bool wide = (e_hi - e_lo) > 1.2 * (n_hi - n_lo);
@@ -349,19 +354,41 @@ void add_drift_figure(Output& out, const ExperimentResult& r) {
                         " m (the drift rate needs at least one segment)");
     return;
   }
+  // A short drive (fewer than 5 segments) would leave each curve one or two points: the
+  // curve is then drawn every l/10 from the per-epoch errors, which the figure runs keep.
+  const bool fine = kmax < 5;
+  const double step = fine ? segment / 10.0 : segment;
+  auto curve_of = [&](const ExperimentRun& run) {
+    if (!fine) return run.eval.drift_curve;
+    std::vector<double> dist, err;
+    for (const auto& e : run.eval.series) dist.push_back(e.distance), err.push_back(e.err_h);
+    return drift_rate_curve(dist, err, step);
+  };
+  std::size_t kplot = 0;
+  for (const auto& run : r.runs)
+    if (!run.centralized && (!fine || run.figure)) kplot = std::max(kplot, curve_of(run).size());
+  if (kplot == 0) {
+    out.notes.push_back(name + ".png not drawn: the drive is shorter than " + num(step) + " m");
+    return;
+  }
+  if (fine)
+    out.notes.push_back(name + ".png: the drive covers " + std::to_string(kmax) + " segment(s) of " + num(segment) +
+                        " m only, so the curves are drawn every " + num(step) + " m, for the figure runs");
   std::string s = script_head(name, "Fig. 10 of the paper: drift rate r_k = max horizontal error within "
                                     "k*l / (k*l) against the distance k*l, every run.");
   s += "set multiplot layout 2,2 title " +
-       gq("Fig. 10: position drift rate against distance, every run - " + dataset_text(r)) +
+       gq(fine ? "Fig. 10: position drift rate against distance, every " + num(step) +
+                     " m (a short drive: the figure runs) - " + dataset_text(r)
+               : "Fig. 10: position drift rate against distance, every run - " + dataset_text(r)) +
        " font \",15\"\nset xlabel \"Distance [m]\"\nset ylabel \"Drift rate [%]\"\n"
-       "set xrange [0:" + num(static_cast<double>(kmax + 1) * segment) + "]\nset yrange [0:*]\n";
+       "set xrange [0:" + num(static_cast<double>(kplot + 1) * step) + "]\nset yrange [0:*]\n";
   const std::string key = "set key top right font \",10\" maxrows 8 opaque box\n";
   const char letters[] = {'a', 'b', 'c', 'd'};
   for (int p = 0; p < 4; ++p) {
     const std::string config = kConfigs[p];
     std::vector<const ExperimentRun*> runs;
     for (const auto& run : r.runs)
-      if (run.configuration == config && !run.centralized && !run.eval.drift_curve.empty())
+      if (run.configuration == config && !run.centralized && (!fine || run.figure) && !curve_of(run).empty())
         runs.push_back(&run);
     s += "set title " + gq("(" + std::string(1, letters[p]) + ") " + config_title(config)) + "\n";
     if (runs.empty()) {
@@ -373,10 +400,11 @@ void add_drift_figure(Output& out, const ExperimentResult& r) {
     std::string d = "distance_m";
     for (const auto* run : runs) d += "," + run_id(*run) + "_pct";
     d += "\n";
-    for (std::size_t k = 0; k < kmax; ++k) {
-      d += num(static_cast<double>(k + 1) * segment);
-      for (const auto* run : runs)
-        d += "," + (k < run->eval.drift_curve.size() ? num(100.0 * run->eval.drift_curve[k], 6) : "");
+    std::vector<std::vector<double>> curves;
+    for (const auto* run : runs) curves.push_back(curve_of(*run));
+    for (std::size_t k = 0; k < kplot; ++k) {
+      d += num(static_cast<double>(k + 1) * step);
+      for (const auto& c : curves) d += "," + (k < c.size() ? num(100.0 * c[k], 6) : "");
       d += "\n";
     }
     out.files.emplace_back(rel, std::move(d));
@@ -506,7 +534,8 @@ std::vector<fs::path> render_gnuplot(const fs::path& plots, const std::vector<st
   const fs::path abs_plots = fs::absolute(plots);
   for (const auto& name : names) {
     const fs::path png = abs_plots / (name + ".png");
-    const fs::path partial = abs_plots / (name + ".png.partial");
+    // A name of its own: two reports drawing into one directory never share a temporary.
+    const fs::path partial = io_detail::unique_partial(png);
     const ProgramResult pr = run_program(
         {options.gnuplot, "-e",
          "cd " + gq_literal(abs_plots.string()) + "; outfile = " + gq_literal(partial.filename().string()),
@@ -523,8 +552,10 @@ std::vector<fs::path> render_gnuplot(const fs::path& plots, const std::vector<st
     if (pr.exit_code != 0 || !fs::exists(partial, ec)) {
       fs::remove(partial, ec);
       if (warn)
-        warn("gnuplot failed on " + (plots / (name + ".gp")).string() + " (exit " +
-             std::to_string(pr.exit_code) + "): " + first_lines(pr.output, 6));
+        warn("gnuplot failed on " + (plots / (name + ".gp")).string() +
+             (pr.exit_code == 0 ? std::string(" (it exited 0 but wrote no image)")
+                                : " (exit " + std::to_string(pr.exit_code) + ")") +
+             (pr.output.empty() ? std::string() : ": " + first_lines(pr.output, 6)));
       continue;
     }
     fs::rename(partial, png, ec);

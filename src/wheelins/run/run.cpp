@@ -63,6 +63,17 @@ void validate_run_request(const RunRequest& r) {
       throw InputError("module '" + m + "' is listed twice; each module can be used once in a run");
     if (!r.manifest.find(m)) throw InputError(man + ": no module named '" + m + "'");
   }
+  // The odometer file the manifest names: the navigation does not read it (the wheels'
+  // IMUs measure the speed), but a manifest naming a file that is not there is wrong, and
+  // said so rather than passed over.
+  if (r.manifest.odometer_file) {
+    const fs::path f = r.manifest.resolve(*r.manifest.odometer_file);
+    std::error_code ec;
+    if (!fs::is_regular_file(f, ec))
+      throw InputError(man + ": key 'odometer': '" + f.string() + "' " +
+                       (fs::exists(f, ec) ? "is not a regular file" : "does not exist") +
+                       " (fix the path, or remove the key: the run does not need an odometer)");
+  }
   std::set<TrajectoryFormat> formats;
   for (TrajectoryFormat f : r.formats)
     if (!formats.insert(f).second)
@@ -140,6 +151,11 @@ RunResult run_navigation(const RunRequest& r) {
   // The output directory appears complete or not at all (io/output_dir.hpp); it is checked,
   // locked and staged before any work, so a refusal or an unwritable place costs nothing.
   const std::vector<fs::path> outputs = run_output_files(r);
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (outputs[i] == outputs[j])
+        throw InputError(quote(r.manifest.path) + ": two outputs of this run would be " + quote(outputs[i]) +
+                         " (a module named like one of the run's own files?); rename the module");
   std::unique_ptr<OutputDir> out_dir;
   if (!r.output_dir.empty()) {
     OutputDirOptions o;
@@ -148,6 +164,7 @@ RunResult run_navigation(const RunRequest& r) {
     o.inputs.push_back(r.manifest.path);
     for (const auto& name : r.modules) o.inputs.push_back(r.manifest.resolve(r.manifest.find(name)->file));
     if (r.manifest.truth_file) o.inputs.push_back(r.manifest.resolve(*r.manifest.truth_file));
+    o.notice = r.warn;
     out_dir = std::make_unique<OutputDir>(r.output_dir, o);
   }
   auto staged = [&](const fs::path& final_file) { return out_dir->staging() / final_file.filename(); };
@@ -179,9 +196,15 @@ RunResult run_navigation(const RunRequest& r) {
     if (spec->layout == FileLayout::kBinary) total_rows += fs::file_size(file, ec) / (7 * sizeof(double));
   }
   ImuMerger merger(std::move(readers));
+  // The record index of every stream's next sample (the merger holds one ahead), so that an
+  // error of the navigation names the record it came at.
+  std::vector<std::uint64_t> head_record(checked.size());
+  for (std::size_t k = 0; k < checked.size(); ++k) head_record[k] = checked[k]->reader().index();
 
   // Writers: the vehicle solution in every format, the subsystems as CSV.
   TrajectoryWriterOptions wopt;
+  wopt.tum_frame = r.tum_frame;
+  wopt.origin = r.manifest.origin;  // the local frame of the records' p_inN
   std::vector<std::unique_ptr<TrajectoryWriter>> vehicle, subsystems;
   if (out_dir) {
     for (TrajectoryFormat f : r.formats)
@@ -255,16 +278,28 @@ RunResult run_navigation(const RunRequest& r) {
   // filter's own cost, without file reading, at two clock reads per 4096 samples.
   constexpr std::size_t kBlock = 4096;
   std::vector<std::pair<std::size_t, ImuSample>> block(kBlock);
+  std::vector<std::uint64_t> record(kBlock);
   std::uint64_t n = 0;
   double filter_seconds = 0.0;
   bool more = true, stop = false;
   while (more && !stop) {
     std::size_t count = 0;
-    while (count < kBlock && (more = merger.next(block[count].first, block[count].second))) ++count;
+    while (count < kBlock && (more = merger.next(block[count].first, block[count].second))) {
+      const std::size_t k = block[count].first;
+      record[count] = head_record[k];
+      head_record[k] = checked[k]->reader().index();
+      ++count;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < count; ++k) {
       const ImuSample& s = block[k].second;
-      nav.process(static_cast<int>(block[k].first), s);
+      try {
+        nav.process(static_cast<int>(block[k].first), s);
+      } catch (const OutageError& e) {
+        throw InputError(std::string(e.what()) + " (record " + std::to_string(record[k]) +
+                         ", 0-based, is the first after the gap); nothing was written. Cut the data at the "
+                         "gap and run the parts apart, or raise faults.max_outage_s");
+      }
       if (r.max_duration > 0 && nav.navigating() && s.t - nav.stats().t_start >= r.max_duration) {
         stop = true;
         break;
@@ -289,6 +324,8 @@ RunResult run_navigation(const RunRequest& r) {
 
   nav.finish();
   check_finite(nav.stats().t_end);
+  if (r.warn)
+    for (const auto& w : nav.faults().warnings()) r.warn(w);
   if (pipe) pipe->finish();  // every record written (or the writer's error thrown)
   RunResult result;
   for (auto& w : vehicle) w->commit();
@@ -335,6 +372,7 @@ RunResult run_navigation(const RunRequest& r) {
     result.fault_report = "input faults:\n" + input_faults + result.fault_report;
   }
   result.fault_events = nav.faults().events();
+  for (int i = 0; i < nav.faults().size(); ++i) result.fault_stats.push_back(nav.faults().stats(i));
   result.files = outputs;
   for (auto& f : result.files) f = out_dir ? out_dir->final_path(f.filename()) : f;
   result.stats = nav.stats();

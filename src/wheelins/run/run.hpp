@@ -22,6 +22,8 @@ struct RunRequest {
   std::filesystem::path output_dir;  ///< empty: nothing is written (the sink still runs)
   std::vector<TrajectoryFormat> formats{TrajectoryFormat::kCsv, TrajectoryFormat::kTum,
                                         TrajectoryFormat::kKml};
+  /// trajectory.tum's convention (its header names it and the manifest's origin).
+  TumFrame tum_frame = TumFrame::kNed;
   bool overwrite = false;
   bool write_subsystems = true;      ///< also <module>.csv per subsystem (multi-IMU runs)
   bool progress = true;              ///< a progress line on a terminal
@@ -46,6 +48,7 @@ struct RunResult {
   std::vector<std::filesystem::path> files;  ///< what was written
   std::string fault_report;                  ///< readable summary of the fault handling
   std::vector<FaultEvent> fault_events;      ///< every detection and what was done
+  std::vector<ModuleFaultStats> fault_stats; ///< per module, in the order of the request's modules (faults.csv)
   std::vector<ModuleNoiseReport> noise;      ///< the noise model per module (noise.yaml)
   std::string noise_report;                  ///< readable summary of it, with the warnings
   std::vector<WeightRecord> weights;         ///< the reference weights of eq. (8) over time (weights.csv)

@@ -49,14 +49,15 @@ CalibrationMode calibration_mode_from_name(const std::string& name) {
 ReferenceWeighting weighting_from_name(const std::string& name) {
   if (name == "equal") return ReferenceWeighting::kFixed;
   if (name == "covariance") return ReferenceWeighting::kCovariance;
-  throw InputError("reference weights '" + name + "': expected equal or covariance");
+  if (name == "standalone") return ReferenceWeighting::kStandalone;
+  throw InputError("reference weights '" + name + "': expected equal, covariance or standalone");
 }
 
 RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   const YamlReader y(file, warn, "run configuration");
   const YAML::Node& root = y.root();
   y.check_keys(root, "", {"dataset", "configuration", "chips", "modules", "output", "duration_s",
-                          "calibration", "data_checks", "filter", "fusion", "faults", "noise"});
+                          "calibration", "data_checks", "filter", "fusion", "faults", "noise", "standstill"});
   RunConfig c;
   const fs::path base = file.parent_path();
   auto rel = [&](const std::string& p) { return fs::path(p).is_absolute() ? fs::path(p) : base / p; };
@@ -81,7 +82,7 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
 
   if (auto out = y.get(root, "output"); out.IsDefined()) {
     y.require_map(out, "output");
-    y.check_keys(out, "output", {"dir", "formats", "interval_s", "overwrite", "subsystems"});
+    y.check_keys(out, "output", {"dir", "formats", "interval_s", "overwrite", "subsystems", "tum_frame"});
     if (auto v = y.get(out, "dir"); v.IsDefined()) c.output_dir = rel(y.text(v, "output.dir"));
     if (auto v = y.get(out, "formats"); v.IsDefined()) {
       c.formats.clear();
@@ -90,6 +91,11 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
           y.fail("output.formats", "unknown format '" + f + "' (csv, tum or kml)", &v);
         c.formats.push_back(trajectory_format_from_name(f));
       }
+    }
+    if (auto v = y.get(out, "tum_frame"); v.IsDefined()) {
+      const std::string f = y.text(v, "output.tum_frame");
+      if (f != "ned" && f != "enu") y.fail("output.tum_frame", "'" + f + "': expected ned or enu", &v);
+      c.tum_frame = tum_frame_from_name(f);
     }
     if (auto v = y.get(out, "interval_s"); v.IsDefined()) {
       c.nav.output_interval = y.number_in(v, "output.interval_s", kRange.output_interval[0],
@@ -204,12 +210,13 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
     }
     if (auto v = y.get(f, "weights"); v.IsDefined() && v.IsScalar()) {
       // equal (the paper) | covariance (from each subsystem's uncertainty) | a list.
-      if (v.Scalar() != "equal" && v.Scalar() != "covariance")
+      if (v.Scalar() != "equal" && v.Scalar() != "covariance" && v.Scalar() != "standalone")
         y.fail("fusion.weights",
-               "expected equal or covariance (or a list of one positive weight per module), got " +
+               "expected equal, covariance or standalone (or a list of one positive weight per "
+               "module), got " +
                    YamlReader::describe(v),
                &v);
-      o.weighting = v.Scalar() == "covariance" ? ReferenceWeighting::kCovariance : ReferenceWeighting::kFixed;
+      o.weighting = weighting_from_name(v.Scalar());
     } else if (v.IsDefined()) {
       o.weights = y.number_list(v, "fusion.weights");
       if (o.weights.empty()) y.fail("fusion.weights", "an empty list (leave it out for equal weights)", &v);
@@ -247,6 +254,31 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
       o.bias_floor = y.number_in(v, "noise.min_gyro_bias_deg_h", 0.0, 1e4, "deg/h") * kDeg / 3600.0;
   }
 
+  if (auto f = y.get(root, "standstill"); f.IsDefined()) {
+    // Zero-velocity detection while standing (docs/faults.md, "Standing still").
+    y.require_map(f, "standstill");
+    y.check_keys(f, "standstill", {"enabled", "max_rate_deg_s", "max_force_spread_m_s2", "block_s", "min_time_s",
+                                   "velocity_std_m_s", "rate_std_deg_s"});
+    StandstillOptions& o = c.nav.standstill;
+    if (auto v = y.get(f, "enabled"); v.IsDefined()) o.enabled = y.boolean(v, "standstill.enabled");
+    if (auto v = y.get(f, "max_rate_deg_s"); v.IsDefined())
+      o.max_rate = y.number_in(v, "standstill.max_rate_deg_s", 0.001, 100.0, "deg/s") * kDeg;
+    if (auto v = y.get(f, "max_force_spread_m_s2"); v.IsDefined())
+      o.max_force_spread = y.number_in(v, "standstill.max_force_spread_m_s2", 0.001, 100.0, "m/s^2");
+    if (auto v = y.get(f, "block_s"); v.IsDefined()) o.block = y.number_in(v, "standstill.block_s", 0.001, 10.0, "s");
+    if (auto v = y.get(f, "min_time_s"); v.IsDefined())
+      o.min_time = y.number_in(v, "standstill.min_time_s", 0.01, 3600.0, "s");
+    if (auto v = y.get(f, "velocity_std_m_s"); v.IsDefined())
+      o.velocity_std = y.number_in(v, "standstill.velocity_std_m_s", 1e-6, 10.0, "m/s");
+    if (auto v = y.get(f, "rate_std_deg_s"); v.IsDefined())
+      o.rate_std = y.number_in(v, "standstill.rate_std_deg_s", 1e-6, 100.0, "deg/s") * kDeg;
+    try {
+      o.validate();
+    } catch (const InputError& e) {
+      y.fail("standstill", e.what(), &f);
+    }
+  }
+
   if (auto f = y.get(root, "faults"); f.IsDefined()) {
     y.require_map(f, "faults");
     struct Key {
@@ -267,7 +299,10 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
         {"test_ratio", &FaultOptions::test_ratio, 1.0, 0.1, 1e6, ""},
         {"heading_gate_deg", &FaultOptions::heading_gate, kDeg, 0.01, 180.0, "deg"},
         {"saturation_margin", &FaultOptions::saturation_margin, 1.0, 0.5, 1.0, "(of the full scale)"},
-        {"saturation_hold_s", &FaultOptions::saturation_hold, 1.0, 0.001, 60.0, "s"}};
+        {"saturation_hold_s", &FaultOptions::saturation_hold, 1.0, 0.001, 60.0, "s"},
+        {"max_outage_s", &FaultOptions::max_outage, 1.0, 0.01, 1e6, "s"},
+        {"reverse_speed_m_s", &FaultOptions::reverse_speed, 1.0, 0.01, 100.0, "m/s"},
+        {"reverse_time_s", &FaultOptions::reverse_time, 1.0, 0.1, 3600.0, "s"}};
     std::vector<std::string> names{"enabled", "window", "max_failed", "heading_epochs"};
     for (const auto& k : kKeys) names.push_back(k.name);
     y.check_keys(f, "faults", names);
@@ -314,6 +349,7 @@ RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn) {
     r.output_dir = fs::path("results") / name;
   }
   r.formats = cfg.formats;
+  r.tum_frame = cfg.tum_frame;
   r.overwrite = cfg.overwrite;
   r.write_subsystems = cfg.write_subsystems;
   r.max_duration = cfg.max_duration;

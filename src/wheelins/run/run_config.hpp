@@ -19,6 +19,7 @@ struct RunConfig {
   std::filesystem::path output_dir;        ///< default: results/<configuration>[-chips]
   std::vector<TrajectoryFormat> formats{TrajectoryFormat::kCsv, TrajectoryFormat::kTum,
                                         TrajectoryFormat::kKml};
+  TumFrame tum_frame = TumFrame::kNed;     ///< output.tum_frame: ned | enu
   bool overwrite = false;
   bool write_subsystems = true;
   double max_duration = 0.0;

@@ -5,11 +5,17 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <cstdio>
 #include <functional>
 #include <sstream>
 
+#include "wheelins/io/manifest.hpp"
+#include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins::sim {
@@ -59,8 +65,39 @@ double get_double(const YAML::Node& n, const std::string& where) {
   try {
     return n.as<double>();
   } catch (const YAML::Exception&) {
-    throw InputError(where + ": expected a number");
+    throw InputError(where + ": expected a number, got " +
+                     (n.IsScalar() ? "'" + n.Scalar() + "'" : n.IsDefined() && !n.IsNull() ? "a list or mapping" : "nothing"));
   }
+}
+/// A whole number up to `hi` (a seed, a count; its range is checked by validate()), naming
+/// the key and the value otherwise.
+std::uint64_t get_whole(const YAML::Node& n, const std::string& where, std::uint64_t hi) {
+  if (n.IsScalar()) {
+    const std::string& s = n.Scalar();
+    errno = 0;
+    char* end = nullptr;
+    const unsigned long long x = std::strtoull(s.c_str(), &end, 10);
+    if (!s.empty() && std::isdigit(static_cast<unsigned char>(s[0])) && *end == '\0' && errno == 0 && x <= hi)
+      return x;
+  }
+  throw InputError(where + ": expected a whole number (0 to " + std::to_string(hi) + "), got " +
+                   (n.IsScalar() ? "'" + n.Scalar() + "'" : std::string("a list or mapping")));
+}
+bool get_bool(const YAML::Node& n, const std::string& where) {
+  if (n.IsScalar()) {
+    std::string s = n.Scalar();
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (s == "true" || s == "yes" || s == "on") return true;
+    if (s == "false" || s == "no" || s == "off") return false;
+  }
+  throw InputError(where + ": expected true or false, got " +
+                   (n.IsScalar() ? "'" + n.Scalar() + "'" : std::string("a list or mapping")));
+}
+std::string get_text(const YAML::Node& n, const std::string& where) {
+  if (!n.IsScalar() || n.Scalar().empty())
+    throw InputError(where + ": expected a name, got " +
+                     (n.IsScalar() ? std::string("nothing") : std::string("a list or mapping")));
+  return n.Scalar();
 }
 Vec3 get_vec(const YAML::Node& n, const std::string& where, HumanUnit u) {
   if (!n.IsSequence() || n.size() != 3) throw InputError(where + ": expected [x, y, z]");
@@ -226,42 +263,42 @@ void SimConfig::only(const std::vector<std::string>& names) {
   }
 }
 
-void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
+void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where, const KeyOrigin& key_origin) {
   if (!node.IsMap()) throw InputError(where + ": expected a map of settings");
   static const std::set<std::string> known = {
       "seed", "profile", "effects", "scenario", "speed_file", "duration_s", "rate_hz", "chips",
       "gps_week", "earth_rotation", "start_time_s", "origin", "static_s", "laps", "speed_m_s",
-      "stops", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "start_steering_deg",
+      "stops", "stop_s", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "start_steering_deg",
       "vehicle", "errors", "faults"};
+  auto key = [&](const std::string& k) { return where + ": " + k + (key_origin ? key_origin(k) : std::string()); };
   for (const auto& kv : node) {
-    const auto k = kv.first.as<std::string>();
-    if (!known.count(k)) throw InputError(where + ": unknown key '" + k + "'");
+    const auto k = get_text(kv.first, where + ": a key");
+    if (!known.count(k)) throw InputError(key(k) + ": unknown key '" + k + "'");
   }
-  auto key = [&](const std::string& k) { return where + ": " + k; };
   try {
     // Profile and preset first: they reset what they own.
-    if (node["profile"]) set_profile(node["profile"].as<std::string>());
+    if (node["profile"]) set_profile(get_text(node["profile"], key("profile")));
     if (node["vehicle"] && node["vehicle"]["preset"])
-      vehicle = VehicleConfig::preset_named(node["vehicle"]["preset"].as<std::string>());
+      vehicle = VehicleConfig::preset_named(get_text(node["vehicle"]["preset"], key("vehicle.preset")));
     if (node["effects"]) {
       std::vector<std::string> list;
-      for (const auto& e : node["effects"]) list.push_back(e.as<std::string>());
+      for (const auto& e : node["effects"]) list.push_back(get_text(e, key("effects")));
       only(list);
     }
-    if (node["seed"]) seed = node["seed"].as<std::uint64_t>();
-    if (node["scenario"]) scenario = node["scenario"].as<std::string>();
+    if (node["seed"]) seed = get_whole(node["seed"], key("seed"), std::numeric_limits<std::uint64_t>::max());
+    if (node["scenario"]) scenario = get_text(node["scenario"], key("scenario"));
     if (node["speed_file"]) {
       if (node["speed_file"].IsNull()) speed_file.reset();
-      else speed_file = node["speed_file"].as<std::string>();
+      else speed_file = get_text(node["speed_file"], key("speed_file"));
     }
     if (node["duration_s"]) {
       if (node["duration_s"].IsNull()) duration.reset();
       else duration = get_double(node["duration_s"], key("duration_s"));
     }
     if (node["rate_hz"]) rate_hz = get_double(node["rate_hz"], key("rate_hz"));
-    if (node["chips"]) chips = node["chips"].as<int>();
+    if (node["chips"]) chips = static_cast<int>(get_whole(node["chips"], key("chips"), 1000000));
     if (node["gps_week"]) gps_week = get_double(node["gps_week"], key("gps_week"));
-    if (node["earth_rotation"]) earth_rotation = node["earth_rotation"].as<bool>();
+    if (node["earth_rotation"]) earth_rotation = get_bool(node["earth_rotation"], key("earth_rotation"));
     if (node["start_time_s"]) {
       if (node["start_time_s"].IsNull()) start_time.reset();
       else start_time = get_double(node["start_time_s"], key("start_time_s"));
@@ -279,8 +316,9 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
       }
     }
     if (node["static_s"]) static_duration = get_double(node["static_s"], key("static_s"));
-    if (node["laps"]) laps = node["laps"].as<int>();
-    if (node["stops"]) stops = node["stops"].as<bool>();
+    if (node["laps"]) laps = static_cast<int>(get_whole(node["laps"], key("laps"), 1000000));
+    if (node["stops"]) stops = get_bool(node["stops"], key("stops"));
+    if (node["stop_s"]) stop_s = get_double(node["stop_s"], key("stop_s"));
     auto opt_double = [&](const char* k, std::optional<double>& dst) {
       if (!node[k]) return;
       if (node[k].IsNull()) dst.reset();
@@ -299,8 +337,8 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
                                                "left-wheel", "right-wheel", "body", "front-left-wheel",
                                                "front-right-wheel"};
       for (const auto& kv : v)
-        if (!vk.count(kv.first.as<std::string>()))
-          throw InputError(key("vehicle") + ": unknown key '" + kv.first.as<std::string>() + "'");
+        if (!vk.count(get_text(kv.first, key("vehicle"))))
+          throw InputError(key("vehicle") + ": unknown key '" + kv.first.Scalar() + "'");
       for (const char* f : {"front-left-wheel", "front-right-wheel"})
         if (v[f] && vehicle.front.empty())
           throw InputError(key(std::string("vehicle.") + f) + ": the vehicle preset '" + vehicle.preset +
@@ -321,7 +359,7 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
         if (!mn) continue;
         const std::string w = key("vehicle." + m->group);
         for (const auto& kv : mn) {
-          const auto k = kv.first.as<std::string>();
+          const auto k = get_text(kv.first, w);
           if (k != "position_m" && k != "mounting_deg" && !(m->wheel && k == "lever_arm_m"))
             throw InputError(w + ": unknown key '" + k + "'");
         }
@@ -332,7 +370,7 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where) {
     }
     if (const auto& e = node["errors"]) {
       for (const auto& kv : e) {
-        const auto k = kv.first.as<std::string>();
+        const auto k = get_text(kv.first, key("errors"));
         bool found = false;
         for (const auto& ek : kErrorKeys)
           if (k == ek.key) {
@@ -388,6 +426,7 @@ void SimConfig::validate() const {
   if (duration) check(*duration, 0.0, 86400.0, "duration_s", "--duration", "s", true);
   if (speed) check(*speed, 0.05, 60.0, "speed_m_s", "--cruise-speed", "m/s");
   check(static_duration, 0.0, 3600.0, "static_s", "--static", "s");
+  check(stop_s, 1.0, 86400.0, "stop_s", "", "s");
   check(terrain_slope_deg, 0.0, 30.0, "terrain_slope_deg", "--terrain", "deg");
   check(vehicle.wheel_radius, 0.01, 2.0, "vehicle.wheel_radius_m", "--radius", "m");
   check(vehicle.track, 0.05, 10.0, "vehicle.track_m", "--track", "m");
@@ -427,6 +466,37 @@ void SimConfig::validate() const {
       throw InputError("simulator setting errors.vibration_*_band_hz: expected 0 < low < high, got [" +
                        std::to_string(band[0]) + ", " + std::to_string(band[1]) + "]");
   check(errors.wheel_accel_noise_rest, 0.0, 1.0, "errors.wheel_accel_noise_rest", "", "");
+  // What the dataset's manifest will say must be what `run` accepts (ManifestLimits): the
+  // full scales when they are simulated, and the geometry with room for the installation
+  // calibration error drawn on it (5 sigma).
+  if (on("saturation")) {
+    check(errors.gyro_range / kDeg, ManifestLimits::kGyroRangeMinDps, ManifestLimits::kGyroRangeMaxDps,
+          "errors.gyro_range_deg_s", "", "deg/s (a manifest's gyro_range_dps)");
+  }
+  const int rate_samples = static_cast<int>(std::floor(static_duration * rate_hz + 1e-9));
+  if (rate_samples < kMinStaticSamples)
+    throw InputError("simulator setting static_s (--static): " + human(static_duration, kSi) +
+                     " s at " + human(rate_hz, kSi) + " Hz gives " + std::to_string(rate_samples) +
+                     " samples at rest; the initial alignment of `wheelins run` needs at least " +
+                     std::to_string(kMinStaticSamples) + " (at least " +
+                     human(kMinStaticSamples / rate_hz, kSi) + " s)");
+  for (const ModuleGeometry* g : vehicle.modules()) {
+    const double pos_room = ManifestLimits::kPositionM - 5.0 * errors.cal_position;
+    const double arm_room = ManifestLimits::kWheelLeverArmM - 5.0 * errors.cal_lever_arm;
+    for (int i = 0; i < 3; ++i) {
+      if (!(std::abs(g->p_inV[i]) <= pos_room))
+        throw InputError("simulator setting vehicle." + g->group + ".position_m: " + human(g->p_inV[i], kSi) +
+                         " m on axis " + std::to_string(i) + "; a manifest's position_v_m is at most " +
+                         human(ManifestLimits::kPositionM, kSi) + " m per axis (" + human(pos_room, kSi) +
+                         " m leaves room for errors.calibration_position_m)");
+      if (g->wheel && !(std::abs(g->lever_arm_inB[i]) <= arm_room))
+        throw InputError("simulator setting vehicle." + g->group + ".lever_arm_m: " +
+                         human(g->lever_arm_inB[i], kSi) + " m on axis " + std::to_string(i) +
+                         "; a wheel's lever_arm_b_m in a manifest is at most " +
+                         human(ManifestLimits::kWheelLeverArmM, kSi) + " m per axis (" + human(arm_room, kSi) +
+                         " m leaves room for errors.calibration_lever_arm_m)");
+    }
+  }
 }
 
 void SimConfig::apply_setting(const std::string& assignment) {
@@ -434,12 +504,7 @@ void SimConfig::apply_setting(const std::string& assignment) {
   if (eq == std::string::npos || eq == 0)
     throw InputError("--set '" + assignment + "': expected key.path=value");
   const std::string path = assignment.substr(0, eq);
-  YAML::Node value;
-  try {
-    value = YAML::Load(assignment.substr(eq + 1));
-  } catch (const YAML::Exception& ex) {
-    throw InputError("--set '" + assignment + "': " + ex.what());
-  }
+  const YAML::Node value = parse_yaml(assignment.substr(eq + 1), "--set '" + assignment + "'", "setting");
   // Build {a: {b: {c: value}}}.
   std::vector<std::string> parts;
   std::size_t pos = 0;
@@ -492,6 +557,7 @@ std::string SimConfig::to_yaml() const {
   o << "speed_m_s: " << opt_text(speed) << "\n";
   o << "loop_scale: " << opt_text(loop_scale) << "\n";
   o << "stops: " << (stops ? "true" : "false") << "\n";
+  if (stop_s != 15.0) o << "stop_s: " << human(stop_s, kSi) << "\n";
   o << "path_sigma_m: " << (path_sigma ? human(*path_sigma, kSi) : std::string("null")) << "\n";
   o << "speed_sigma_s: " << (speed_sigma ? human(*speed_sigma, kSi) : std::string("null")) << "\n";
   o << "terrain_slope_deg: " << human(terrain_slope_deg, kSi) << "\n";

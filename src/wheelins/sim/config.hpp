@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -146,6 +147,7 @@ struct SimConfig {
   std::optional<double> speed;         ///< cruise speed; default 1.4 m/s (robot), 6 m/s (car)
   std::optional<double> loop_scale;    ///< default scenario size; default 1 (robot), 4 (car)
   bool stops = true;
+  double stop_s = 15.0;                 ///< each stop of the default scenario [s] (~7 s less at rest)
   std::optional<double> path_sigma;     ///< default: 2.0 m (default scenario), 0.7 m (files)
   std::optional<double> speed_sigma;    ///< default: 1.2 s / 0.5 s
   double terrain_slope_deg = 0.0;       ///< 0: flat
@@ -165,8 +167,12 @@ struct SimConfig {
   /// Removes / restricts effects (names checked: InputError for unknown ones).
   void disable(const std::vector<std::string>& names);
   void only(const std::vector<std::string>& names);
-  /// Applies the keys present in a YAML map (the scenario.yaml format), `where` names it.
-  void apply_yaml(const YAML::Node& node, const std::string& where);
+  /// Where a dotted key of a YAML map came from, appended to messages about it (e.g. a
+  /// study's " (sweep.seed, line 7)"); none: the messages name `where` and the key.
+  using KeyOrigin = std::function<std::string(const std::string& key)>;
+  /// Applies the keys present in a YAML map (the scenario.yaml format), `where` names it;
+  /// a value of the wrong type is an InputError naming `where`, the key and the value.
+  void apply_yaml(const YAML::Node& node, const std::string& where, const KeyOrigin& key_origin = {});
   /// Applies "a.b.c=value" (value parsed as YAML).
   void apply_setting(const std::string& assignment);
   /// Every number in its range (docs/simulator.md); InputError naming the setting and its

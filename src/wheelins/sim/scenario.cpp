@@ -369,7 +369,7 @@ PathScenarioSpec default_scenario_spec(const DefaultScenarioOptions& opt) {
   };
   for (int l = 1; l <= opt.laps; ++l) {
     drive_to(u0 + lead + l * lap_len);
-    if (opt.stops && l < opt.laps && l % 2 == 0) dwell(15.0);  // ~8 s fully stopped
+    if (opt.stops && l < opt.laps && l % 2 == 0) dwell(opt.stop_duration);  // 15 s: ~8 s fully stopped
   }
   s.end_time = t + 6.0 * opt.profile_sigma + 20.0;
   s.profile_t.push_back(s.end_time);

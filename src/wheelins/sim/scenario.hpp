@@ -126,6 +126,7 @@ struct DefaultScenarioOptions {
   double path_sigma = 2.0;   ///< corner rounding [m] (turn radius ~1.8 m)
   double profile_sigma = 1.2;  ///< speed smoothing [s] (peak acceleration ~0.47 m/s^2)
   bool stops = true;         ///< stop for ~8 s after laps 2 and 4
+  double stop_duration = 15.0;  ///< [s] each stop, of which about 7 s (6 speed sigmas) slowing and starting
   double rotation_deg = 25.0;  ///< heading of the T's stem
   double scale = 1.0;          ///< size of the T (1: 254 m per lap)
   double skid_coeff = 0.0;

@@ -64,6 +64,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     o.path_sigma = cfg_.path_sigma.value_or(car ? 8.0 : 2.0);
     o.profile_sigma = cfg_.speed_sigma.value_or(car ? 2.5 : 1.2);
     o.stops = cfg_.stops;
+    o.stop_duration = cfg_.stop_s;
     o.skid_coeff = skid;
     o.terrain = terrain;
     // The front axle's centre (wheelbase, 0) turned by D: kappa = tan(D) / wheelbase.

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdlib>
 
+#include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
 #include "wheelins/sim/simulator.hpp"
 #include "wheelins/study/files.hpp"
@@ -89,13 +90,8 @@ void absolutize(YAML::Node node, const char* key, const fs::path& base) {
 
 std::string edit_manifest(const std::string& text, const std::string& edits,
                           const fs::path& base_dir, const std::string& where) {
-  YAML::Node root, list;
-  try {
-    root = YAML::Load(text);
-    list = YAML::Load(edits);
-  } catch (const YAML::Exception& e) {
-    throw InputError(where + ": " + e.what());
-  }
+  const YAML::Node root = parse_yaml(text, where, "manifest");
+  const YAML::Node list = parse_yaml(edits, where + ": the manifest edits", "list of edits");
   if (!root.IsMap()) throw InputError(where + ": the manifest is not a mapping");
   for (const auto& item : list) {
     for (const auto& kv : item) {

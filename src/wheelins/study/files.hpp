@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace wheelins::study {
 
@@ -24,6 +25,26 @@ void write_file_atomic(const std::filesystem::path& file, std::string_view text,
 
 /// The whole file; nullopt-like empty string and false when it cannot be read.
 bool read_file(const std::filesystem::path& file, std::string& out);
+
+/// The files a study report wrote into its results directory, listed in `.wheelins-report`
+/// there (one relative path a line). A report replaces only those: a file of the same name
+/// that it did not write (the user's own report.md or plots/a.gp) is refused, with or
+/// without --force. A directory reported into before the list existed: a file counts as the
+/// report's when its first line is the one the report writes there.
+class ReportFiles {
+ public:
+  explicit ReportFiles(const std::filesystem::path& dir);
+  /// Throws InputError if `dir/rel` exists and is not the report's. `first_line`: what the
+  /// report writes on its first line (for a directory without the list; "" matches nothing).
+  void check(const std::filesystem::path& rel, const std::string& first_line) const;
+  /// Records `rel` as written and saves the list (atomically).
+  void add(const std::vector<std::filesystem::path>& rels);
+
+ private:
+  std::filesystem::path dir_;
+  bool listed_ = false;
+  std::vector<std::string> names_;
+};
 
 /// This machine's name ("host" if it has none).
 std::string host_name();

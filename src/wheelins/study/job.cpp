@@ -21,6 +21,7 @@
 
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/truth.hpp"
+#include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
@@ -364,9 +365,11 @@ JobStatus job_status(const Study& s, const Job& j) {
   if (read_file(failure_file(s, j.index), text) && key_in(text) == j.key) {
     st.state = JobState::kFailed;
     try {
-      const YAML::Node n = YAML::Load(text);
+      const YAML::Node n = parse_yaml(text, "failure record", "failure record");
       st.detail = n["error"].as<std::string>();
     } catch (const YAML::Exception&) {
+      st.detail = "(the failure record cannot be read)";
+    } catch (const InputError&) {
       st.detail = "(the failure record cannot be read)";
     }
   }

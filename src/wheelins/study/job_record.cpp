@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
 #include "wheelins/study/files.hpp"
 
@@ -56,7 +57,7 @@ std::optional<JobRecord> read_job_record(const fs::path& file, std::string& erro
   }
   JobRecord r;
   try {
-    const YAML::Node n = YAML::Load(text);
+    const YAML::Node n = parse_yaml(text, "'" + file.string() + "'", "study result");
     if (n["format"].as<std::string>() != kJobResultFormat) {
       error = "'" + file.string() + "': not a study result (format " +
               n["format"].as<std::string>() + ")";
@@ -135,6 +136,9 @@ std::optional<JobRecord> read_job_record(const fs::path& file, std::string& erro
     r.timing.host = t["host"].as<std::string>();
   } catch (const YAML::Exception& ex) {
     error = "'" + file.string() + "': cannot be read as a study result: " + ex.what();
+    return std::nullopt;
+  } catch (const InputError& ex) {
+    error = std::string(ex.what()) + " (cannot be read as a study result)";
     return std::nullopt;
   }
   if (with_series) {

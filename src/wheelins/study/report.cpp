@@ -154,6 +154,18 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
     }
     md << "\n";
   }
+  // The pairs compared: the study's `compare`, else every configuration against the first.
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  std::vector<std::string> titles;
+  for (const auto& [a, b] : s.compare()) {
+    const auto ia = std::find(L.config_labels.begin(), L.config_labels.end(), a) - L.config_labels.begin();
+    const auto ib = std::find(L.config_labels.begin(), L.config_labels.end(), b) - L.config_labels.begin();
+    pairs.emplace_back(static_cast<std::size_t>(ia), static_cast<std::size_t>(ib));
+    titles.push_back(b + " - " + a);
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> plot_pairs = pairs;
+  if (plot_pairs.empty())
+    for (std::size_t k = 1; k < L.configurations; ++k) plot_pairs.emplace_back(0, k);
   if (!s.compare().empty()) {
     md << "## Paired differences (B - A on the same data)\n\n"
        << "Each cell: mean of the differences B - A over the replicates both have ± their standard "
@@ -163,16 +175,6 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
           "interval "
           "that excludes 0 means the difference is larger than the spread between replicates "
           "explains.\n\n";
-    std::vector<std::pair<std::size_t, std::size_t>> pairs;
-    std::vector<std::string> titles;
-    for (const auto& [a, b] : s.compare()) {
-      const auto ia =
-          std::find(L.config_labels.begin(), L.config_labels.end(), a) - L.config_labels.begin();
-      const auto ib =
-          std::find(L.config_labels.begin(), L.config_labels.end(), b) - L.config_labels.begin();
-      pairs.emplace_back(static_cast<std::size_t>(ia), static_cast<std::size_t>(ib));
-      titles.push_back(b + " - " + a);
-    }
     for (int metric : {kDrift, kHeading}) {
       const Metric& m = kMetrics[metric];
       md << "### " << m.title << " (" << m.unit << ")\n\n";
@@ -211,10 +213,18 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
   if (o.plots && rep.done > 0) {
     add_metric_plot(plots, s, L, g, kDrift, "drift");
     add_metric_plot(plots, s, L, g, kHeading, "heading");
-    md << "## Plots\n\n`plots/drift.png`, `plots/heading.png`: the mean and its interval per "
-          "condition and "
-          "configuration, with every job as a small point (data in `plots/data/`, gnuplot scripts "
-          "`plots/*.gp`).\n\n";
+    md << "## Plots\n\n`plots/drift.png`, `plots/heading.png`: per condition (x axis) and "
+          "configuration, the mean (square) and its "
+       << interval_description(io.method, io.confidence, io.resamples)
+       << " (error bars), with every job as a small point";
+    if (!plot_pairs.empty()) {
+      add_paired_plot(plots, s, L, g, kDrift, plot_pairs, "paired_drift");
+      md << "; `plots/paired_drift.png`: the paired differences B - A of the drift rate, run by run on the "
+            "same data ("
+         << (s.compare().empty() ? "every configuration against the first" : "the study's `compare` pairs")
+         << "), each pair a small point, their mean and its interval; below the dashed zero line B is better";
+    }
+    md << " (data in `plots/data/`, gnuplot scripts `plots/*.gp`).\n\n";
   }
 
   if (!not_done.empty()) {
@@ -375,9 +385,21 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
   const std::vector<std::pair<std::string, std::string>> files = {
       {"report.md", rep.markdown}, {"summary.csv", summary_csv}, {"differences.csv", diff_csv},
       {"jobs.csv", jobs_csv},      {"report.json", js.text()},   {"timing.csv", timing_csv}};
+  // The report replaces only what a report wrote here (files.hpp): every file is checked
+  // before the first is written.
+  ReportFiles ours(dir);
+  auto first_line = [](const std::string& t) { return t.substr(0, t.find('\n')); };
+  for (const auto& [name, text] : files) ours.check(name, first_line(text));
+  std::vector<fs::path> written;
+  if (!plots.names.empty()) {
+    for (const auto& [rel, text] : plots.files) ours.check(fs::path("plots") / rel, first_line(text));
+    if (o.plot.render)
+      for (const auto& n : plots.names) ours.check(fs::path("plots") / (n + ".png"), "\x89PNG\r");
+  }
   for (const auto& [name, text] : files) {
     write_file_atomic(dir / name, text);
     rep.files.push_back(dir / name);
+    written.push_back(name);
   }
   if (!plots.names.empty()) {
     const fs::path pdir = dir / "plots";
@@ -385,11 +407,15 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
     for (const auto& [rel, text] : plots.files) {
       write_file_atomic(pdir / rel, text);
       rep.files.push_back(pdir / rel);
+      written.push_back(fs::path("plots") / rel);
     }
     if (o.plot.render)
-      for (auto& f : eval::render_gnuplot(pdir, plots.names, o.warn, o.plot))
+      for (auto& f : eval::render_gnuplot(pdir, plots.names, o.warn, o.plot)) {
+        written.push_back(fs::path("plots") / f.filename());
         rep.files.push_back(std::move(f));
+      }
   }
+  ours.add(written);
   rep.jobs = std::move(jobs);
   return rep;
 }
@@ -410,6 +436,7 @@ Report experiment_report(const Study& s, std::vector<JobEntry> jobs, const Repor
   r.dataset_name = m.name;
   r.truth_file = m.resolve(*m.truth_file);
   r.origin = m.origin;
+  r.duration = x.duration;
   double first = INFINITY, last = -INFINITY;
   for (const auto& e : jobs) {
     if (!e.record) {

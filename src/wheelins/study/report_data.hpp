@@ -128,5 +128,9 @@ struct PlotFiles {
 /// condition and configuration, over the single jobs' values (small points).
 void add_metric_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid& g, int metric,
                      const std::string& name);
+/// Adds a plot of the paired differences B - A of `metric` (`pairs`: (A, B) configuration
+/// indices) per condition: every replicate's difference and their mean with its interval.
+void add_paired_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid& g, int metric,
+                     const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::string& name);
 
 }  // namespace wheelins::study::report_detail

@@ -30,19 +30,33 @@ std::string gq(const std::string& s) {
 
 }  // namespace
 
-void add_metric_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid& g, int metric,
-                     const std::string& name) {
-  const Metric& m = kMetrics[metric];
+namespace {
+
+// One plot of groups: per condition (x) and series (offset within the condition), the mean and
+// its interval (error bars) over the replicates, and every replicate's value as a small point.
+struct GroupPlot {
+  std::string name, title, ylabel, what;  // `what`: the small points, for the key
+  std::vector<std::string> series;        // the key's titles
+  // values[condition][series][replicate] (NaN: none)
+  std::vector<std::vector<std::vector<double>>> values;
+  bool zero_line = false;
+};
+
+void write_group_plot(PlotFiles& out, const Study& s, const Layout& L, const GroupPlot& p) {
   const IntervalOptions& io = s.interval();
+  const std::size_t K = p.series.size();
   std::string summary = "condition,label";
   std::string jobs = "condition";
-  for (const auto& c : L.config_labels) {
+  for (const auto& c : p.series) {
     summary += "," + c + "_mean," + c + "_lo," + c + "_hi";
     jobs += "," + c;
   }
   summary += "\n";
   jobs += "\n";
-  double ymax = 0.0;
+  double ymax = 0.0, ymin = 0.0;
+  auto grow = [&](double v) {
+    if (std::isfinite(v)) ymax = std::max(ymax, v), ymin = std::min(ymin, v);
+  };
   auto condition_label = [&](std::size_t c) {
     std::string label;
     for (const auto& l : L.labels(c, L.cond, s)) label += (label.empty() ? "" : " / ") + l;
@@ -53,70 +67,62 @@ void add_metric_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid
     for (char& ch : label)
       if (ch == ',') ch = ';';
     summary += std::to_string(c) + "," + label;
-    for (std::size_t k = 0; k < L.configurations; ++k) {
-      const Summary sm = summarize(values_of(g.records[c][k], metric), io);
+    std::size_t reps = 0;
+    for (std::size_t k = 0; k < K; ++k) {
+      std::vector<double> v;
+      for (double x : p.values[c][k])
+        if (std::isfinite(x)) v.push_back(x);
+      reps = std::max(reps, p.values[c][k].size());
+      const Summary sm = summarize(v, io);
       summary += "," + exact(sm.mean) + "," + exact(sm.n >= 2 ? sm.lo : sm.mean) + "," +
                  exact(sm.n >= 2 ? sm.hi : sm.mean);
-      if (sm.n >= 2 && std::isfinite(sm.hi)) ymax = std::max(ymax, sm.hi);
+      if (sm.n >= 2) grow(sm.hi), grow(sm.lo);
     }
     summary += "\n";
-    for (std::size_t r = 0; r < L.replicates; ++r) {
+    for (std::size_t r = 0; r < reps; ++r) {
       std::string row = std::to_string(c);
       bool any = false;
-      for (std::size_t k = 0; k < L.configurations; ++k) {
-        const JobRecord* rec = g.records[c][k][r];
-        const double v = rec ? m.get(*rec) : std::nan("");
-        if (std::isfinite(v)) any = true, ymax = std::max(ymax, v);
+      for (std::size_t k = 0; k < K; ++k) {
+        const double v = r < p.values[c][k].size() ? p.values[c][k][r] : std::nan("");
+        if (std::isfinite(v)) any = true, grow(v);
         row += "," + exact(v);
       }
       if (any) jobs += row + "\n";
     }
   }
-  out.files.emplace_back(fs::path("data") / (name + "_summary.csv"), summary);
-  out.files.emplace_back(fs::path("data") / (name + "_jobs.csv"), jobs);
+  out.files.emplace_back(fs::path("data") / (p.name + "_summary.csv"), summary);
+  out.files.emplace_back(fs::path("data") / (p.name + "_jobs.csv"), jobs);
 
-  const std::size_t K = L.configurations;
   const double width = 0.7 / static_cast<double>(K);
   const int px = static_cast<int>(
       std::clamp<double>(200.0 + 70.0 * static_cast<double>(L.conditions * K), 1200.0, 4000.0));
-  const std::string unit = m.unit[0] ? std::string(" [") + m.unit + "]" : "";
-  std::string xtics;
+  std::string xtics, xlabel;
   std::size_t longest = 0;
   for (std::size_t c = 0; c < L.conditions; ++c) {
     const std::string label = condition_label(c);
     longest = std::max(longest, label.size());
     xtics += (c ? ", " : "") + gq(label) + " " + std::to_string(c);
   }
-  char top[32];
-  std::snprintf(top, sizeof top, "%.4g", ymax > 0 ? 1.1 * ymax : 1.0);
-  const int bmargin = static_cast<int>(std::clamp<std::size_t>(3 + longest / 2, 4, 16));
-  std::string gp =
-      "# " + std::string(m.title) + " by condition: mean and " +
-      interval_description(io.method, io.confidence, io.resamples) +
-      " per configuration; small points: the single jobs.\n"
-      "# Written by `wheelins study report`; edit and re-run in this directory: gnuplot " +
-      name +
-      ".gp\n"
-      "if (!exists(\"outfile\")) outfile = " +
-      gq(name + ".png") +
-      "\n"
-      "set terminal pngcairo size " +
-      std::to_string(px) +
-      ",800 noenhanced font \"Sans,13\" linewidth 1.3\n"
-      "set output outfile\nset datafile separator \",\"\nset grid ytics lc rgb \"#d0d0d0\"\n"
-      "set title " +
-      gq(std::string(m.title) + " by condition - " + s.name()) +
-      " font \",15\"\n"
-      "set ylabel " +
-      gq(std::string(m.title) + unit) +
-      "\n"
-      "set xrange [-0.5:" +
-      std::to_string(L.conditions) + "-0.5]\nset yrange [0:" + exact(ymax > 0 ? 1.1 * ymax : 1.0) +
-      "]\n"
-      "set xtics (" +
-      xtics + ") rotate by -25 left nomirror\nset bmargin " + std::to_string(bmargin) +
-      "\n"
-      "set key outside top center horizontal samplen 2\nplot \\\n";
+  for (std::size_t a : L.cond) xlabel += (xlabel.empty() ? "" : " / ") + s.axes()[a].name;
+  xlabel = xlabel.empty() ? "the study (one condition)" : "condition: " + xlabel;
+  const double lo = ymin < 0.0 ? 1.1 * ymin : 0.0, hi = ymax > 0.0 ? 1.1 * ymax : (ymin < 0.0 ? 0.0 : 1.0);
+  const int bmargin = static_cast<int>(std::clamp<std::size_t>(5 + longest / 2, 6, 18));
+  const std::string bars = interval_description(io.method, io.confidence, io.resamples);
+  std::string gp = "# " + p.title + ": mean and " + bars + " per series; small points: " + p.what +
+                   ".\n"
+                   "# Written by `wheelins study report`; edit and re-run in this directory: gnuplot " +
+                   p.name + ".gp\n" + "if (!exists(\"outfile\")) outfile = " + gq(p.name + ".png") +
+                   "\nset terminal pngcairo size " + std::to_string(px) +
+                   ",800 noenhanced font \"Sans,13\" linewidth 1.3\n"
+                   "set output outfile\nset datafile separator \",\"\nset grid ytics lc rgb \"#d0d0d0\"\n"
+                   "set title " + gq(p.title + " - " + s.name()) + " font \",15\"\n" +
+                   "set ylabel " + gq(p.ylabel) + "\nset xlabel " + gq(xlabel) + "\n" +
+                   "set xrange [-0.5:" + std::to_string(L.conditions) + "-0.5]\nset yrange [" + exact(lo) + ":" +
+                   exact(hi) + "]\n" + "set xtics (" + xtics + ") rotate by -25 left nomirror\nset bmargin " +
+                   std::to_string(bmargin) + "\n" + "set key outside top center horizontal samplen 2\n" +
+                   (p.zero_line ? "set arrow from graph 0, first 0 to graph 1, first 0 nohead lc rgb \"#404040\" dt 2\n"
+                                : "") +
+                   "plot \\\n";
   std::vector<std::string> parts;
   for (std::size_t k = 0; k < K; ++k) {
     const double off = (static_cast<double>(k) - 0.5 * static_cast<double>(K - 1)) * width;
@@ -124,18 +130,59 @@ void add_metric_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid
     std::snprintf(o, sizeof o, "%+.4f", off);
     std::snprintf(oj, sizeof oj, "%+.4f", off + 0.3 * width);
     const std::string color = gq(kColors[k % 10]);
-    parts.push_back("  \"data/" + name + "_jobs.csv\" skip 1 using ($1" + oj +
-                    "):" + std::to_string(k + 2) + " with points pt 7 ps 0.5 lc rgb " + color +
-                    " notitle");
-    parts.push_back("  \"data/" + name + "_summary.csv\" skip 1 using ($1" + o +
-                    "):" + std::to_string(3 + 3 * k) + ":" + std::to_string(4 + 3 * k) + ":" +
-                    std::to_string(5 + 3 * k) + " with yerrorbars pt 5 ps 1.1 lw 2 lc rgb " +
-                    color + " title " + gq(L.config_labels[k]));
+    parts.push_back("  \"data/" + p.name + "_jobs.csv\" skip 1 using ($1" + oj + "):" + std::to_string(k + 2) +
+                    " with points pt 7 ps 0.5 lc rgb " + color + " notitle");
+    parts.push_back("  \"data/" + p.name + "_summary.csv\" skip 1 using ($1" + o + "):" + std::to_string(3 + 3 * k) +
+                    ":" + std::to_string(4 + 3 * k) + ":" + std::to_string(5 + 3 * k) +
+                    " with yerrorbars pt 5 ps 1.1 lw 2 lc rgb " + color + " title " + gq(p.series[k]));
   }
-  for (std::size_t i = 0; i < parts.size(); ++i)
-    gp += parts[i] + (i + 1 < parts.size() ? ", \\\n" : "\n");
-  out.files.emplace_back(name + ".gp", gp);
-  out.names.push_back(name);
+  // What the marks are, in the key itself.
+  parts.push_back("  NaN with yerrorbars pt 5 ps 1.1 lw 2 lc rgb \"#000000\" title " +
+                  gq("square and bars: mean and its " + bars));
+  parts.push_back("  NaN with points pt 7 ps 0.5 lc rgb \"#000000\" title " + gq("small points: " + p.what));
+  for (std::size_t i = 0; i < parts.size(); ++i) gp += parts[i] + (i + 1 < parts.size() ? ", \\\n" : "\n");
+  out.files.emplace_back(p.name + ".gp", gp);
+  out.names.push_back(p.name);
+}
+
+}  // namespace
+
+void add_metric_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid& g, int metric,
+                     const std::string& name) {
+  const Metric& m = kMetrics[metric];
+  GroupPlot p;
+  p.name = name;
+  p.title = std::string(m.title) + " by condition";
+  p.ylabel = std::string(m.title) + (m.unit[0] ? std::string(" [") + m.unit + "]" : "");
+  p.what = "one run each";
+  p.series = L.config_labels;
+  p.values.assign(L.conditions, std::vector<std::vector<double>>(L.configurations));
+  for (std::size_t c = 0; c < L.conditions; ++c)
+    for (std::size_t k = 0; k < L.configurations; ++k)
+      for (const JobRecord* rec : g.records[c][k]) p.values[c][k].push_back(rec ? m.get(*rec) : std::nan(""));
+  write_group_plot(out, s, L, p);
+}
+
+void add_paired_plot(PlotFiles& out, const Study& s, const Layout& L, const Grid& g, int metric,
+                     const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::string& name) {
+  const Metric& m = kMetrics[metric];
+  GroupPlot p;
+  p.name = name;
+  p.title = std::string(m.title) + ": paired differences B - A on the same runs";
+  p.ylabel = "B - A, " + std::string(m.title) + (m.unit[0] ? std::string(" [") + m.unit + "]" : "") +
+             " (below 0: B better)";
+  p.what = "one pair of runs on the same data each";
+  p.zero_line = true;
+  p.values.assign(L.conditions, std::vector<std::vector<double>>(pairs.size()));
+  for (const auto& [a, b] : pairs) p.series.push_back(L.config_labels[b] + " - " + L.config_labels[a]);
+  for (std::size_t c = 0; c < L.conditions; ++c)
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const auto& A = g.records[c][pairs[k].first];
+      const auto& B = g.records[c][pairs[k].second];
+      for (std::size_t r = 0; r < A.size(); ++r)
+        p.values[c][k].push_back(A[r] && B[r] ? m.get(*B[r]) - m.get(*A[r]) : std::nan(""));
+    }
+  write_group_plot(out, s, L, p);
 }
 
 }  // namespace wheelins::study::report_detail

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "wheelins/io/text_util.hpp"
+#include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
 
 namespace wheelins::study {
@@ -93,6 +94,7 @@ std::size_t imu_count(const std::string& configuration) {
 }
 
 std::string fnv_of_file(const fs::path& p, const std::string& what) {
+  io_detail::check_input_file(p, "a " + what);  // a regular file: /dev/zero or a FIFO never ends
   std::ifstream in(p, std::ios::binary);
   if (!in) throw InputError("'" + p.string() + "': " + what + " not found or unreadable");
   std::stringstream ss;
@@ -240,7 +242,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
   };
   auto text_of = [&](const Setting& s) {
     if (!s.value.IsScalar() || s.value.Scalar().empty())
-      throw InputError(who + ": " + s.where + ": " + s.key + ": expected a text value");
+      throw InputError(who + ": " + s.origin() + ": " + s.key + ": expected a text value");
     return s.value.Scalar();
   };
   auto list_of = [&](const Setting& s) {
@@ -252,7 +254,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
     } else if (s.value.IsSequence()) {
       for (const auto& x : s.value) out.push_back(x.as<std::string>());
     } else {
-      throw InputError(who + ": " + s.where + ": " + s.key + ": expected a list");
+      throw InputError(who + ": " + s.origin() + ": " + s.key + ": expected a list");
     }
     return out;
   };
@@ -261,6 +263,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
   std::string dataset_where, sim_where;
   Tree sim_tree, run_tree;
   std::vector<std::string> sim_configs, sim_sets, faults, disable;
+  std::map<std::string, std::string> sim_origin;  // dotted simulator key -> where it was set
   std::optional<std::vector<std::string>> only;
   std::optional<std::string> wheel_noise;
   std::optional<bool> earth_rotation;
@@ -271,11 +274,11 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
     if (s.key == "dataset") {
       dataset = rel(text_of(s));
       if (fs::is_directory(*dataset)) *dataset /= "manifest.yaml";
-      dataset_where = s.where;
+      dataset_where = s.origin();
       continue;
     }
     if (s.key == "seed" || s.key.rfind("simulate.", 0) == 0) {
-      sim_where = s.where;
+      sim_where = s.origin();
       std::string key = s.key == "seed" ? "seed" : s.key.substr(9);
       const std::string first = split_dotted(key)[0];
       const auto& alias = sim_alias();
@@ -295,14 +298,15 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
         try {
           earth_rotation = !s.value.as<bool>();
         } catch (const YAML::Exception&) {
-          throw InputError(who + ": " + s.where +
+          throw InputError(who + ": " + s.origin() +
                            ": simulate.no_earth_rotation: expected true or false");
         }
       } else if (key == "no_ideal" || key == "out" || key == "force" || key == "quiet")
-        throw InputError(who + ": " + s.where + ": simulate." + key +
+        throw InputError(who + ": " + s.origin() + ": simulate." + key +
                          " is an output choice of `wheelins simulate`, not a setting of the data");
       else {
         if (const auto a = alias.find(first); a != alias.end() && key == first) key = a->second;
+        sim_origin[key] = s.origin();
         if (key == "scenario" || key == "speed_file") {
           const std::string p = text_of(s);
           sim_tree.set(split_dotted(key), 0,
@@ -348,20 +352,21 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
       for (const auto& f : sim_configs) {
         YAML::Node node;
         try {
-          node = YAML::LoadFile(f);
-        } catch (const YAML::Exception& e) {
-          throw InputError(where + ": '" + f + "': " + e.what());
+          node = load_yaml_file(f, "simulator settings");
+        } catch (const InputError& e) {
+          throw InputError(where + ": " + e.what());
         }
         c.apply_yaml(node, where + " ('" + f + "')");
       }
       if (!sim_tree.kids.empty()) {
-        YAML::Node node;
-        try {
-          node = YAML::Load(sim_tree.text());
-        } catch (const YAML::Exception& e) {
-          throw InputError(where + ": " + e.what());
-        }
-        c.apply_yaml(node, where);
+        // A message about a key names the study's setting that gave it (its key and line).
+        const auto origin = [&](const std::string& k) {
+          for (std::string p = k;; p = p.substr(0, p.rfind('.'))) {
+            if (const auto it = sim_origin.find(p); it != sim_origin.end()) return " (set by " + it->second + ")";
+            if (p.find('.') == std::string::npos) return std::string();
+          }
+        };
+        c.apply_yaml(parse_yaml(sim_tree.text(), where, "simulator settings"), where, origin);
       }
       try {
         for (const auto& a : sim_sets) c.apply_setting(a);
@@ -387,7 +392,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
       if (memo.size() > 100000) memo.clear();
       SimMemo& m = memo[memo_key];
       m.data = d;
-      flatten(YAML::Load(d.sim->to_yaml()), "", m.values);
+      flatten(parse_yaml(d.sim->to_yaml(), where, "simulator settings"), "", m.values);
       sim_values = &m.values;
     }
   } else {
@@ -413,11 +418,11 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
   };
   for (const Setting* sp : later) {
     const Setting& s0 = *sp;
-    const Setting s{s0.key, substitute(s0.value, lookup, s0.where), s0.where};
+    const Setting s{s0.key, substitute(s0.value, lookup, s0.where), s0.where, s0.line};
     if (s.key.rfind("run.", 0) == 0) {
       const std::string key = s.key.substr(4);
       if (key == "dataset")
-        throw InputError(who + ": " + s.where +
+        throw InputError(who + ": " + s.origin() +
                          ": run.dataset: give the data with `dataset` or `simulate`");
       run_tree.set(split_dotted(key), 0, s.value);
     } else if (s.key.rfind("manifest.", 0) == 0) {
@@ -431,7 +436,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
       for (const auto& c : list_of(s)) seq.push_back(c);
       run_tree.set({s.key}, 0, seq);
     } else {
-      throw InputError(who + ": " + s.where + ": unknown setting '" + s.key + "'");
+      throw InputError(who + ": " + s.origin() + ": unknown setting '" + s.key + "'");
     }
   }
   if (const Tree* out = run_tree.find("output")) {
@@ -453,7 +458,7 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
   std::string cfg = configuration.value_or("");
   if (cfg.empty()) {
     if (const Tree* t = run_tree.find("configuration"); t && t->leaf)
-      cfg = YAML::Load(*t->leaf).as<std::string>();
+      cfg = text_of({"run.configuration", parse_yaml(*t->leaf, who, "setting"), "run.configuration"});
   }
   if (cfg == "centralized") {
     run_tree.set({"configuration"}, 0, YAML::Node("triple"));

@@ -183,7 +183,7 @@ struct Loader {
                closest(key, special_keys()),
            &v);
     }
-    return {key, YAML::Clone(v), where};
+    return {key, YAML::Clone(v), where, v.Mark().is_null() ? 0 : static_cast<std::size_t>(v.Mark().line) + 1};
   }
 
   /// A map of settings: dotted keys (or, inside `simulate:`, `run:`, `manifest:`, plain keys).
@@ -360,6 +360,13 @@ std::string experiment_study_yaml(const ExperimentSpec& e) {
   return s;
 }
 
+void check_experiment_only(const std::vector<std::string>& only, const std::string& where) {
+  for (const auto& o : only)
+    if (o != "single" && o != "dual-wheel" && o != "body-wheel" && o != "triple" && o != "centralized")
+      throw InputError(where + ": unknown configuration '" + o +
+                       "' (single, dual-wheel, body-wheel, triple, centralized)");
+}
+
 Study Study::load(const fs::path& file, const LoadOptions& options) {
   const YamlReader y(
       file,
@@ -439,13 +446,11 @@ Study Study::load(const fs::path& file, const LoadOptions& options) {
     if (fs::is_directory(x.dataset)) x.dataset /= "manifest.yaml";
     if (auto v = YamlReader::get(e, "only"); v.IsDefined())
       x.only = y.text_list(v, "experiment.only");
-    for (const auto& o : x.only)
-      if (o != "single" && o != "dual-wheel" && o != "body-wheel" && o != "triple" &&
-          o != "centralized")
-        y.fail("experiment.only",
-               "unknown configuration '" + o +
-                   "' (single, dual-wheel, body-wheel, triple, centralized)",
-               &e);
+    try {
+      check_experiment_only(x.only, "experiment.only");
+    } catch (const InputError& err) {
+      y.fail("", err.what(), &e);
+    }
     if (auto v = YamlReader::get(e, "speed"); v.IsDefined())
       x.speed = y.choice<std::string>(v, "experiment.speed", {{"mean", "mean"}, {"own", "own"}});
     if (auto v = YamlReader::get(e, "calibration"); v.IsDefined())

@@ -41,7 +41,10 @@ namespace wheelins::study {
 struct Setting {
   std::string key;
   YAML::Node value;
-  std::string where;
+  std::string where;  ///< the key path in the study file ("sweep.seed"), or the option
+  std::size_t line = 0;  ///< its line in the study file (0: none, e.g. a generated setting)
+  /// `where` with the line, for messages: "sweep.seed (line 7)".
+  std::string origin() const { return line ? where + " (line " + std::to_string(line) + ")" : where; }
 };
 
 enum class AxisRole { kCondition, kReplicate, kConfiguration };
@@ -173,6 +176,10 @@ void check_run_yaml(const std::string& run_yaml, const std::string& where);
 
 /// The study file text of the built-in experiment on `spec` (results in the file's directory).
 std::string experiment_study_yaml(const ExperimentSpec& spec);
+/// Checks the configurations of `experiment.only` (`wheelins experiment --only`): an unknown
+/// one is an InputError "WHERE: unknown configuration 'X' (single, ...)"; the command checks
+/// its option with this before it writes the study, so the error names the option.
+void check_experiment_only(const std::vector<std::string>& only, const std::string& where);
 
 /// "a.b.c" -> {"a", "b", "c"}.
 std::vector<std::string> split_dotted(const std::string& key);
