@@ -41,6 +41,21 @@ std::vector<std::string> split_list(const std::string& text) {
   return out;
 }
 
+/// The first option of the command line (of `app` and the subcommands parsed) given an
+/// empty value, e.g. `-o ''` or `--job $K` with K unset: its name, or "" if none. An empty
+/// value is an error, never taken as "not given" (which would pick a default directory or
+/// every job).
+std::string option_with_empty_value(const CLI::App& app) {
+  for (const CLI::Option* opt : app.get_options()) {
+    if (opt->get_type_size() == 0 || opt->count() == 0) continue;  // a flag, or not given
+    for (const std::string& v : opt->results())
+      if (v.empty()) return opt->get_name();
+  }
+  for (const CLI::App* sub : app.get_subcommands())
+    if (const std::string name = option_with_empty_value(*sub); !name.empty()) return name;
+  return "";
+}
+
 }  // namespace wheelins::cli
 
 namespace {
@@ -88,6 +103,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  }
+  if (const std::string name = option_with_empty_value(app); !name.empty()) {
+    std::cerr << "error: " << name << ": an empty value (an unset variable?); give a value or leave the option out\n";
+    return 2;
   }
   for (auto& [sub, run] : runners) {
     if (!sub->parsed()) continue;
