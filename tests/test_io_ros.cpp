@@ -483,7 +483,11 @@ TEST_F(RosImport, GenericTopicNamesDraftAManifestThatNavigates) {
   EXPECT_EQ(todo.find("position_v_m"), std::string::npos);
   EXPECT_EQ(todo.find("track_m"), std::string::npos);
   EXPECT_NE(todo.find("wheel_radius_m"), std::string::npos);
+#if WHEELINS_HAVE_ROS1
   EXPECT_NE(todo.find("/ground_truth/odom (nav_msgs/Odometry)"), std::string::npos);
+#else
+  EXPECT_NE(todo.find("/ground_truth/odom (nav_msgs/msg/Odometry)"), std::string::npos);  // ROS 2's type name
+#endif
   EXPECT_NE(todo.find("--truth TOPIC"), std::string::npos);
 
   // It navigates: the distances from the start agree with the truth's (no heading is known,
