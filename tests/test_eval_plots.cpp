@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -268,6 +269,60 @@ TEST(EvalPlots, GnuplotDrawsPngs) {
   int listed = 0;
   for (const auto& f : w.files) listed += f.extension() == ".png";
   EXPECT_EQ(listed, pngs);
+}
+
+// Overlaid tracks stay visible where they lie on top of each other (issue 34): the first
+// drawn is the widest, each later one narrower and dashed differently, all a little
+// transparent.
+TEST(EvalPlots, OverlaidTracksDifferInWidthAndDash) {
+  ScratchDir dir;
+  eval::PlotOptions o;
+  o.render = false;
+  write(dir, false, o);
+  std::vector<double> widths;
+  std::set<std::string> dashes;
+  for (const auto& l : lines_of(dir / "plots" / "trajectory.gp")) {
+    const auto lw = l.find(" with lines lw ");
+    if (lw == std::string::npos || l.find("track_") == std::string::npos) continue;
+    widths.push_back(std::stod(l.substr(lw + 15)));
+    const auto dt = l.find(" dt ");
+    ASSERT_NE(dt, std::string::npos) << l;
+    dashes.insert(l.substr(dt + 4, l.find(' ', dt + 4) - dt - 4));
+    EXPECT_NE(l.find("lc rgb \"#30"), std::string::npos) << l;  // ARGB: a little transparent
+  }
+  ASSERT_GE(widths.size(), 4u);
+  for (std::size_t i = 1; i < widths.size(); ++i) EXPECT_LE(widths[i], widths[i - 1]);
+  EXPECT_GT(widths.front(), widths.back());
+  EXPECT_EQ(dashes.size(), 4u);  // one dash pattern per configuration
+}
+
+// Fig. 10 on a short drive (fewer than 5 segments of l, issue 34): each curve would be one or
+// two points; it is drawn every l/10 from the figure runs' per-epoch errors instead, and a
+// note says so.
+TEST(EvalPlots, ShortDriveDrawsFig10EveryTenthOfASegment) {
+  ScratchDir dir;
+  const earth::LocalFrame frame(kOrigin);
+  eval::ExperimentResult r = synthetic_result(frame);
+  for (auto& run : r.runs) {
+    run.eval.drift_curve.resize(2);  // 2 segments of 100 m
+    std::erase_if(run.eval.series, [](const eval::EpochError& e) { return e.distance > 250.0; });
+  }
+  std::vector<std::string> notes;
+  eval::PlotOptions o;
+  o.render = false;
+  eval::write_experiment_plots(r, circle_truth(frame), frame, dir.path(), false,
+                               [&](const std::string& m) { notes.push_back(m); }, o);
+  bool said = false;
+  for (const auto& n : notes) said = said || n.find("curves are drawn every 10 m") != std::string::npos;
+  EXPECT_TRUE(said);
+  const auto single = lines_of(dir / "plots/data/drift_single.csv");
+  ASSERT_GT(single.size(), 20u);  // every 10 m up to 250 m, not two points
+  EXPECT_DOUBLE_EQ(std::stod(split(single[1])[0]), 10.0);
+  // The per-epoch errors grow as 1 % of the distance for error scale 1 (left C1).
+  const auto row = split(single[10]);
+  EXPECT_DOUBLE_EQ(std::stod(row[0]), 100.0);
+  EXPECT_NEAR(std::stod(row[1]), 1.0, 0.05);
+  EXPECT_NE(read_all(dir / "plots/fig10_drift_rate.gp").find("a short drive"), std::string::npos);
 }
 
 // Two reports drawing the same figures into one directory at once (issue 33, item 17): each

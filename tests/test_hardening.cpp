@@ -236,6 +236,24 @@ TEST_F(Hardening, RunNumbersOutsideTheirRangeAreErrors) {
   EXPECT_HAS(error_of([&] { run_navigation(r); }), "listed twice");
 }
 
+// A manifest naming an odometer file that is not there (issue 33, "also seen"): the run does
+// not read it, but the manifest is wrong and the error names the key and the file.
+TEST_F(Hardening, AMissingOdometerFileIsAnErrorNamingTheKey) {
+  const fs::path d = variant("no-odometer");
+  std::string text = read_all(d / "manifest.yaml");
+  const std::size_t at = text.find("\nodometer:");
+  ASSERT_NE(at, std::string::npos) << "the simulated manifest names no odometer";
+  text.replace(at + 1, text.find('\n', at + 1) - at - 1, "odometer: odo-gone.bin");
+  iotest::write_text(d / "manifest.yaml", text);
+  RunRequest r = request(d, "single");
+  const std::string e = error_of([&] { run_navigation(r); });
+  EXPECT_HAS(e, "key 'odometer'");
+  EXPECT_HAS(e, "odo-gone.bin' does not exist");
+  fs::create_directory(d / "odo-gone.bin");
+  r = request(d, "single");
+  EXPECT_HAS(error_of([&] { run_navigation(r); }), "is not a regular file");
+}
+
 TEST(HardeningSim, SettingsAreCheckedOnceAllAreIn) {
   sim::SimConfig c;
   c.duration = -10.0;

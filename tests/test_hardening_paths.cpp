@@ -266,6 +266,26 @@ TEST(HardeningPaths, AnImportCleansUpAfterAKilledOneAndNeverWritesOverItsRecordi
              "an output never replaces an input");
 }
 
+// simulate --force over a dataset that holds a run's results and the user's notes (issue 33,
+// item 4): the dataset's own files are replaced, the rest is kept and named.
+TEST(HardeningPaths, SimulateForceKeepsARunsResultsInsideTheDataset) {
+  iotest::ScratchDir dir;
+  ASSERT_EQ(cli("simulate --out ds --duration 30 --static 5 --chips 1 --no-ideal -q", dir.path()).code, 0);
+  ASSERT_EQ(cli("run -m ds/manifest.yaml -c single -o ds/results -q", dir.path()).code, 0);
+  iotest::write_text(dir / "ds" / "notes.txt", "mine\n");
+  const std::string traj = iotest::read_text_file(dir / "ds" / "results" / "trajectory.csv");
+  const fs::path imu = dir / "ds" / "left-wheel-imu" / "tri_C1_imu.bin";
+  const auto size5 = fs::file_size(imu);
+  const Cmd again = cli("simulate --out ds --duration 31 --static 5 --chips 1 --no-ideal --force", dir.path());
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_HAS(again.err, "kept what wheelins did not write there: ");
+  EXPECT_HAS(again.err, "'results'");
+  EXPECT_HAS(again.err, "'notes.txt'");
+  EXPECT_EQ(iotest::read_text_file(dir / "ds" / "notes.txt"), "mine\n");
+  EXPECT_EQ(iotest::read_text_file(dir / "ds" / "results" / "trajectory.csv"), traj);
+  EXPECT_GT(fs::file_size(imu), size5);  // the 31 s dataset replaced the 30 s one
+}
+
 TEST(HardeningPaths, AStudyReportReplacesOnlyTheFilesAReportWrote) {
   iotest::ScratchDir dir;
   iotest::write_text(dir / "report.md", "# my own notes\n");

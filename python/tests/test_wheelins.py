@@ -390,3 +390,20 @@ def test_ctrl_c_during_runs_leaves_only_complete_results(dataset, tmp_path):
     # (on a busy machine the first run may be the one interrupted: then there is none)
     for d in tmp_path.iterdir():
         assert {p.name for p in d.iterdir()} >= {"trajectory.csv", "noise.yaml", "faults.csv"}, d
+
+
+def test_force_replaces_only_what_wheelins_wrote(dataset, tmp_path):
+    """run(force=True) over an earlier run's directory replaces that run's files and keeps the
+    user's own (issue 33, item 4); a file of the user's under a name the run writes is refused."""
+    out = tmp_path / "single"
+    wheelins.run(dataset["manifest"], "single", out=out, formats=["csv"], duration=5.0)
+    (out / "notes.txt").write_text("mine")
+    (out / "later-run").mkdir()
+    (out / "later-run" / "trajectory.csv").write_text("my other results")
+    before = (out / "trajectory.csv").read_text()
+    wheelins.run(dataset["manifest"], "single", out=out, formats=["csv"], duration=6.0, force=True)
+    assert (out / "notes.txt").read_text() == "mine"
+    assert (out / "later-run" / "trajectory.csv").read_text() == "my other results"
+    assert (out / "trajectory.csv").read_text() != before
+    with pytest.raises(wheelins.InputError, match="already holds results.*force=True replaces the files"):
+        wheelins.run(dataset["manifest"], "single", out=out, formats=["csv"], duration=5.0)

@@ -162,8 +162,8 @@ OutputDir::OutputDir(const fs::path& target, const OutputDirOptions& options) : 
   if (kind == opt_.kind) {
     if (!opt_.overwrite)
       throw InputError(q + ": already holds " + opt_.kind + " of an earlier command; refusing to "
-                       "overwrite them (" + opt_.overwrite_hint + " replaces them as a whole, or "
-                       "choose another directory)");
+                       "overwrite them (" + opt_.overwrite_hint + " replaces the files wheelins wrote there "
+                       "and keeps the rest, or choose another directory)");
     replace_ = true;
   } else if (kind == "foreign") {
     throw InputError(q + ": holds files that wheelins did not write (e.g. '" + first_entry(target_) +
