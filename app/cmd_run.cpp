@@ -1,4 +1,5 @@
 // `wheelins run`: navigate one configuration of a dataset and write its trajectory.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include "cli.hpp"
 #include "run_report.hpp"
 #include "wheelins/eval/run_evaluation.hpp"
+#include "wheelins/fusion/reference_weights.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
@@ -39,6 +41,9 @@ struct RunArgs {
   bool no_data_checks = false;
   bool force = false;
   bool quiet = false;
+  bool verbose = false;
+  bool full_rate = false;
+  bool subsystems = false;
   std::optional<double> duration, output_interval, covariance_interval, align_start;
   std::string antenna;
 };
@@ -54,6 +59,67 @@ void check_range(const std::optional<double>& v, const char* option, double lo, 
                   lo, hi, unit);
     throw InputError(buf);
   }
+}
+
+/// The statistics of the run every summary starts with: time, updates, covariance checks.
+void print_run_statistics(const RunResult& res) {
+  const NavigatorStats& st = res.stats;
+  const double nav_s = st.t_end - st.t_start;
+  const double epochs = std::max<double>(1.0, static_cast<double>(st.epochs));
+  std::printf("\nnavigated %.1f s (%llu epochs) in %.2f s wall: %.0fx real time, %.2f us per epoch "
+              "(the navigator %.2f us)\n",
+              nav_s, static_cast<unsigned long long>(st.epochs), res.wall_seconds,
+              nav_s / std::max(1e-9, res.wall_seconds), 1e6 * res.wall_seconds / epochs,
+              1e6 * res.filter_seconds / epochs);
+  std::printf("velocity updates: %llu (%llu rejected, max test ratio %.2f)",
+              static_cast<unsigned long long>(st.velocity_updates),
+              static_cast<unsigned long long>(st.velocity_rejected), st.max_velocity_test_ratio);
+  if (st.position_updates)
+    std::printf("; position constraint: %llu (%llu rejected, max %.2f)",
+                static_cast<unsigned long long>(st.position_updates),
+                static_cast<unsigned long long>(st.position_rejected), st.max_position_test_ratio);
+  std::printf("\ncovariance checks: %llu, not positive definite: %llu, max asymmetry %.1e\n",
+              static_cast<unsigned long long>(st.covariance_checks),
+              static_cast<unsigned long long>(st.covariance_not_pd), st.max_covariance_asymmetry);
+}
+
+/// `run -v`: everything, as listed tables (the calibration, the noise model, the weights)
+/// and every file written.
+void print_run_details(const RunRequest& req, const RunResult& res) {
+  print_run_statistics(res);
+  if (req.nav.faults.enabled) std::cout << res.fault_report;
+  std::cout << res.calibration_report << res.noise_report << res.weights_report;
+  for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
+}
+
+/// The short summary (the default): a line each for the calibration, the noise model and the
+/// weights, their warnings on stderr, and where the files went.
+void print_run_summary(const RunRequest& req, const RunResult& res) {
+  print_run_statistics(res);
+  if (req.nav.faults.enabled) std::cout << res.fault_report;
+  if (!res.calibration_report.empty())
+    std::cout << "installation calibration: estimated from the data (calibration.yaml; -v lists it)\n";
+  std::cout << "noise model: " << (req.nav.noise.enabled ? "identified from the data" : "fixed")
+            << " (noise.yaml; -v lists it)\n";
+  const WarningSink warn = req.warn ? req.warn : stderr_sink();
+  for (const auto& n : res.noise)
+    for (const auto& w : n.warnings) warn(w);  // each names its module
+  if (!res.weights.empty()) {
+    const auto s = summarize_weights(res.weights, static_cast<int>(req.modules.size()));
+    std::cout << "reference weights k_i (eq. 8), mean:";
+    for (std::size_t i = 0; i < s.size(); ++i)
+      std::printf("%s %s %.3f", i ? "," : "", req.modules[i].c_str(), s[i].mean);
+    std::cout << " (weights.csv)\n";
+  }
+  if (res.files.empty()) return;
+  std::cout << "wrote " << res.files.size() << " files to "
+            << res.files.front().parent_path().string() << " (";
+  for (std::size_t i = 0; i < res.files.size(); ++i)
+    std::cout << (i ? ", " : "") << res.files[i].filename().string();
+  if (req.file_interval > 0)
+    std::printf("; trajectories every %g s: --full-rate for every epoch", req.file_interval);
+  if (req.modules.size() > 1 && !req.write_subsystems) std::cout << ", --subsystems for each IMU's";
+  std::cout << ")\n";
 }
 
 int run(const RunArgs& a) {
@@ -103,6 +169,8 @@ int run(const RunArgs& a) {
   if (a.fixed_noise) cfg.nav.noise.enabled = false;
   if (a.output_interval) cfg.nav.output_interval = *a.output_interval;
   if (a.covariance_interval) cfg.nav.covariance_interval = *a.covariance_interval;
+  if (a.full_rate) cfg.file_interval = 0.0;
+  if (a.subsystems) cfg.write_subsystems = true;
 
   RunRequest req = make_run_request(cfg, stderr_sink());
   req.progress = !a.quiet;
@@ -122,36 +190,16 @@ int run(const RunArgs& a) {
   std::cout << "wheelins run: " << cfg.configuration << " [";
   for (std::size_t i = 0; i < req.modules.size(); ++i) std::cout << (i ? ", " : "") << req.modules[i];
   std::cout << "] on '" << req.manifest.path.string() << "'\n";
-  if (!a.quiet) std::cout << req.nav.describe();
+  if (a.verbose) std::cout << req.nav.describe();
   if (!req.manifest.heading_known)
     std::cout << "initial heading:            not in the manifest: a local frame (odometry frame, as ROS's odom) "
                  "with the vehicle's heading 0 at the start\n";
 
   const RunResult res = run_navigation(req);
-  const NavigatorStats& st = res.stats;
-  const double nav_s = st.t_end - st.t_start;
-  std::printf("\nnavigated %.1f s (%llu epochs) in %.2f s wall: %.2f us per epoch, %.0fx real time\n",
-              nav_s, static_cast<unsigned long long>(st.epochs), res.wall_seconds,
-              1e6 * res.wall_seconds / std::max<double>(1.0, static_cast<double>(st.epochs)),
-              nav_s / std::max(1e-9, res.wall_seconds));
-  std::printf("navigator incl. output records, excl. input reading, evaluation and file writing: %.2f us per epoch\n",
-              1e6 * res.filter_seconds / std::max<double>(1.0, static_cast<double>(st.epochs)));
-  std::printf("velocity updates: %llu (%llu rejected, max test ratio %.2f)\n",
-              static_cast<unsigned long long>(st.velocity_updates),
-              static_cast<unsigned long long>(st.velocity_rejected), st.max_velocity_test_ratio);
-  if (st.position_updates)
-    std::printf("position-constraint updates: %llu (%llu rejected, max test ratio %.2f)\n",
-                static_cast<unsigned long long>(st.position_updates),
-                static_cast<unsigned long long>(st.position_rejected), st.max_position_test_ratio);
-  std::printf("covariance checks: %llu, not positive definite: %llu, max asymmetry %.1e\n",
-              static_cast<unsigned long long>(st.covariance_checks),
-              static_cast<unsigned long long>(st.covariance_not_pd), st.max_covariance_asymmetry);
-  if (req.nav.faults.enabled) std::cout << res.fault_report;
-  std::cout << res.calibration_report;
-  std::cout << res.noise_report;
-  std::cout << res.weights_report;
-  for (const auto& f : res.files) std::cout << "wrote " << f.string() << "\n";
-
+  if (a.verbose)
+    print_run_details(req, res);
+  else
+    print_run_summary(req, res);
   if (evaluate) {
     eval::EvalResult e;
     try {
@@ -159,7 +207,7 @@ int run(const RunArgs& a) {
     } catch (const InputError& err) {
       throw InputError(std::string(err.what()) + " (the trajectory was written)");
     }
-    print_evaluation(e, evaluation->truth().file().string(), st.t_start, st.t_end,
+    print_evaluation(e, evaluation->truth().file().string(), res.stats.t_start, res.stats.t_end,
                      req.modules.size() > 1 && !req.nav.fusion.centralized);
   }
   return 0;
@@ -222,7 +270,13 @@ const bool registered = cli::register_command(
                      "Covariance time update every this many seconds (F integrated in between); "
                      "0 = every IMU epoch; at most 0.5 s");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
-      sub.add_flag("--quiet,-q", a->quiet, "No progress line and no option listing");
+      sub.add_flag("--quiet,-q", a->quiet, "No progress line");
+      sub.add_flag("--verbose,-v", a->verbose,
+                   "Also the option listing, the calibration, noise and weight tables, and every file written");
+      sub.add_flag("--full-rate", a->full_rate,
+                   "Write the trajectory at every record (default: every 0.1 s, output.file_interval_s)");
+      sub.add_flag("--subsystems", a->subsystems,
+                   "Also write each IMU's own trajectory, <module>.csv (multi-IMU runs)");
       return [a]() { return run(*a); };
     });
 }  // namespace

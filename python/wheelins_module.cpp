@@ -265,12 +265,15 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
               std::optional<double> duration, std::optional<double> output_interval,
               std::optional<double> covariance_interval, const std::string& weights,
               std::optional<bool> fixed_noise, const std::string& yaw_scale_factors,
-              const std::string& calibration, bool force, bool progress) {
+              const std::string& calibration, bool force, bool progress, bool full_rate,
+              bool subsystems) {
   Settings s{configuration, text(config).value_or(""), speed, weights, chips, modules, formats,
              centralized, position_constraint, fault_handling, fixed_noise, duration, output_interval,
              covariance_interval, yaw_scale_factors, calibration};
   RunConfig cfg = run_config(text(manifest).value_or(""), s);
   if (force) cfg.overwrite = true;
+  if (full_rate) cfg.file_interval = 0.0;  // as wheelins run --full-rate
+  if (subsystems) cfg.write_subsystems = true;
   const std::optional<std::string> out_dir = text(out);
   RunRequest req = make_run_request(cfg, stderr_sink());
   req.output_dir = out_dir ? std::filesystem::path(*out_dir) : std::filesystem::path();  // none: nothing written
@@ -686,7 +689,7 @@ PYBIND11_MODULE(_core, m) {
         py::arg("duration") = py::none(), py::arg("output_interval") = py::none(),
         py::arg("covariance_interval") = py::none(), py::arg("weights") = "", py::arg("fixed_noise") = py::none(),
         py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("force") = false,
-        py::arg("progress") = false);
+        py::arg("progress") = false, py::arg("full_rate") = false, py::arg("subsystems") = false);
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
         py::arg("origin") = py::none(), py::arg("series") = false);

@@ -25,7 +25,7 @@ if [ -f "$shared/GINS.kml" ]; then
   have_robot=1
 fi
 
-config() {  # file, dataset, configuration, formats, subsystems
+config() {  # file, dataset, configuration, formats, subsystems[, file interval: default 0 = 200 Hz]
   cat > "$1" <<EOF
 dataset: $(realpath "$data/$2/manifest.yaml")
 configuration: $3
@@ -33,6 +33,7 @@ output:
   dir: $(realpath "$out")/$(basename "$1" .yaml)
   formats: [$4]
   subsystems: $5
+  file_interval_s: ${6:-0}
   overwrite: true
 EOF
 }
@@ -62,6 +63,12 @@ if [ $have_robot = 1 ]; then
   measure "robot run (15 min), single Wheel-IMU, TUM at 200 Hz, no evaluation" "$cfgdir/robot-single-tum.yaml" --no-evaluate
   config "$cfgdir/robot-single-all.yaml" robot single "csv, tum, kml" false
   measure "robot run (15 min), single Wheel-IMU, CSV+TUM+KML at 200 Hz, evaluated" "$cfgdir/robot-single-all.yaml"
+  config "$cfgdir/robot-single-default.yaml" robot single "csv, tum, kml" false 0.1
+  measure "robot run (15 min), single Wheel-IMU, the default output (CSV+TUM+KML at 10 Hz), evaluated" "$cfgdir/robot-single-default.yaml"
+  config "$cfgdir/robot-triple-default.yaml" robot triple "csv, tum, kml" false 0.1
+  measure "robot run (15 min), triple, the default output (CSV+TUM+KML at 10 Hz), evaluated" "$cfgdir/robot-triple-default.yaml"
+  config "$cfgdir/robot-triple-all.yaml" robot triple "csv, tum, kml" true
+  measure "robot run (15 min), triple, all files at 200 Hz (the former default), evaluated" "$cfgdir/robot-triple-all.yaml"
 fi
 config "$cfgdir/default-triple.yaml" default triple "csv, tum, kml" true
 measure "default scenario (1000 s), triple, all files at 200 Hz, evaluated" "$cfgdir/default-triple.yaml"

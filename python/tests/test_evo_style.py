@@ -45,7 +45,7 @@ def test_tum_files_give_the_evaluations_horizontal_rmse(tmp_path):
     sim = tmp_path / "sim"
     cli("simulate", "--out", sim, "--duration", "50", "--static", "10", "--chips", "1", "-q")
     run = tmp_path / "run"
-    cli("run", "-m", sim / "manifest.yaml", "-c", "single", "-o", run, "--tum-frame", "enu", "-q")
+    cli("run", "--full-rate", "-m", sim / "manifest.yaml", "-c", "single", "-o", run, "--tum-frame", "enu", "-q")
     truth_tum = tmp_path / "truth.tum"
     p = cli("evaluate", "--truth", sim / "GINS.bin", "--traj", run / "trajectory.tum", "--export-truth", truth_tum,
             "--json", "-")

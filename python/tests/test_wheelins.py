@@ -58,7 +58,7 @@ def dataset(tmp_path_factory):
 @pytest.fixture(scope="module")
 def cli_triple(dataset, tmp_path_factory):
     out = tmp_path_factory.mktemp("cli")
-    p = cli("run", "-m", dataset["manifest"], "-c", "triple", "-o", out, "-q")
+    p = cli("run", "--full-rate", "-m", dataset["manifest"], "-c", "triple", "-o", out, "-q")
     return out, p.stdout
 
 
@@ -104,8 +104,8 @@ def test_run_gives_the_cli_trajectory_and_figures(dataset, cli_triple):
 
 def test_run_options_and_files(dataset, tmp_path):
     r = wheelins.run(dataset["manifest"], "body-wheel", out=tmp_path / "bw", formats=["csv"], centralized=True,
-                     position_constraint=False, duration=15.0, output_interval=0.1)
-    cli("run", "-m", dataset["manifest"], "-c", "body-wheel", "-o", tmp_path / "cli", "--formats", "csv",
+                     position_constraint=False, duration=15.0, output_interval=0.1, full_rate=True)
+    cli("run", "--full-rate", "-m", dataset["manifest"], "-c", "body-wheel", "-o", tmp_path / "cli", "--formats", "csv",
         "--centralized", "--no-position-constraint", "--duration", 15, "--output-interval", 0.1, "-q")
     same_as_csv(r.trajectory, read_csv(tmp_path / "cli" / "trajectory.csv"))
     same_as_csv(r.trajectory, read_csv(tmp_path / "bw" / "trajectory.csv"))
@@ -117,7 +117,7 @@ def test_run_options_and_files(dataset, tmp_path):
 def test_run_weights_and_fixed_noise_as_the_cli(dataset, tmp_path):
     r = wheelins.run(dataset["manifest"], "triple", out=tmp_path / "py", formats=["csv"], weights="covariance",
                      fixed_noise=True, duration=40.0, output_interval=0.1)
-    cli("run", "-m", dataset["manifest"], "-c", "triple", "-o", tmp_path / "cli", "--formats", "csv",
+    cli("run", "--full-rate", "-m", dataset["manifest"], "-c", "triple", "-o", tmp_path / "cli", "--formats", "csv",
         "--weights", "covariance", "--fixed-noise", "--duration", 40, "--output-interval", 0.1, "-q")
     same_as_csv(r.trajectory, read_csv(tmp_path / "cli" / "trajectory.csv"))
     theirs = read_csv(tmp_path / "cli" / "weights.csv")
@@ -150,7 +150,7 @@ WHEEL_L, WHEEL_R, BODY = "left-wheel-imu/tri_C1_imu.bin", "right-wheel-imu/tri_C
 def test_streaming_navigator_reproduces_the_cli_to_the_last_digit(dataset, tmp_path, configuration, files, settings,
                                                                    flags):
     # The streaming navigator takes the manifest's geometry as it is: so does this run.
-    cli("run", "-m", dataset["manifest"], "-c", configuration, "-o", tmp_path, "-q", "--calibration", "manifest", *flags)
+    cli("run", "--full-rate", "-m", dataset["manifest"], "-c", configuration, "-o", tmp_path, "-q", "--calibration", "manifest", *flags)
     nav = wheelins.Navigator(dataset["manifest"], configuration=configuration, **settings)
     assert len(nav.modules) == len(files)
     # The simulated manifest has no time offsets: merge by the file times, ties in module order.
@@ -187,7 +187,7 @@ def test_streaming_navigator_applies_the_runs_input_checks(dataset, tmp_path):
     rows = load_rows(dataset, WHEEL_L).copy()
     rows[5000, 2] = 1e6  # rad/s
     rows.astype("<f8").tofile(copy / WHEEL_L)
-    p = cli("run", "-m", copy / "manifest.yaml", "-c", "body-wheel", "-o", tmp_path / "out", "-q",
+    p = cli("run", "--full-rate", "-m", copy / "manifest.yaml", "-c", "body-wheel", "-o", tmp_path / "out", "-q",
             "--calibration", "manifest")
     assert "beyond the sensor range" in p.stderr or "beyond the sensor range" in p.stdout
     nav = wheelins.Navigator(copy / "manifest.yaml", configuration="body-wheel")
@@ -204,7 +204,7 @@ def test_streaming_navigator_estimates_the_geometry_over_a_warmup(dataset, tmp_p
     longer than the data is the run's calibration from all of it (the run's trajectory to the
     last digit); a shorter one gives the run's estimates from that many seconds."""
     manifest = dataset["manifest"]
-    cli("run", "-m", manifest, "-c", "body-wheel", "-o", tmp_path / "all", "-q", "--calibration", "estimate")
+    cli("run", "--full-rate", "-m", manifest, "-c", "body-wheel", "-o", tmp_path / "all", "-q", "--calibration", "estimate")
     rows = [load_rows(dataset, WHEEL_L), load_rows(dataset, BODY)]
     order = sorted((r[k, 0], i, k) for i, r in enumerate(rows) for k in range(len(r)))
 
@@ -264,7 +264,7 @@ def test_navigator_from_module_specs(dataset, tmp_path):
     for _, i, k in sorted((r[k, 0], i, k) for i, r in enumerate(rows) for k in range(len(r))):
         nav.push(i, rows[i][k][0], rows[i][k][1:4], rows[i][k][4:7])
     nav.finish()
-    cli("run", "-m", dataset["manifest"], "-c", "triple", "-o", tmp_path, "-q", "--calibration", "manifest")
+    cli("run", "--full-rate", "-m", dataset["manifest"], "-c", "triple", "-o", tmp_path, "-q", "--calibration", "manifest")
     same_as_csv(nav.trajectory, read_csv(tmp_path / "trajectory.csv"))
     spec["modules"][0]["wheel_radius_m"] = -1
     with pytest.raises(wheelins.InputError, match=r"modules\[0\].wheel_radius_m"):

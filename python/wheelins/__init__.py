@@ -149,13 +149,15 @@ class Result:
 
 
 def run(manifest, configuration=None, chips=None, *, modules=None, config=None, out=None, formats=None,
-        evaluate=True, progress=False, force=False, **filter_settings):
+        evaluate=True, progress=False, force=False, full_rate=False, subsystems=False, **filter_settings):
     """Navigates a dataset as `wheelins run` does and returns a Result.
 
     configuration: single | dual-wheel | body-wheel | triple; chips: e.g. ["C1", "C4"]
     (or "C1,C4"); modules: explicit module names; config: a run configuration YAML
     (docs/run-config.md), which the other arguments override; out: a directory to write
-    the trajectory files to (default: none written). filter_settings are the options of
+    the trajectory files to (default: none written): a record every 0.1 s unless
+    full_rate=True, and each IMU's own trajectory with subsystems=True (as `wheelins run
+    --full-rate --subsystems`); the Result holds every record either way. filter_settings are the options of
     `wheelins run` by name: speed="mean", centralized=True, position_constraint=False,
     fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0,
     weights="covariance" (or "equal"), fixed_noise=True, yaw_scale_factors="held" (or "auto",
@@ -167,7 +169,8 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
         chips = [c for c in chips.split(",") if c]
     return Result(_core.run(manifest, configuration=configuration or "", chips=list(chips or []),
                             modules=list(modules or []), config=config, out=out, formats=list(formats or []),
-                            evaluate=evaluate, progress=progress, force=force, **filter_settings))
+                            evaluate=evaluate, progress=progress, force=force, full_rate=full_rate,
+                            subsystems=subsystems, **filter_settings))
 
 
 _SERIES = ["t_s", "distance_m", "err_n_m", "err_e_m", "err_d_m", "err_h_m", "heading_err_deg", "sigma_h_m", "nees_h"]

@@ -13,8 +13,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <limits>
+#include <cstdio>
 #include <iostream>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <set>
 #include <vector>
 
 #include "wheelins/io/diagnostics.hpp"
@@ -23,7 +27,21 @@
 namespace wheelins {
 
 WarningSink stderr_sink() {
-  return [](const std::string& message) { std::cerr << "warning: " << message << "\n"; };
+  // Whole lines, each once: what stdout holds so far goes out first (a log that takes both
+  // gets no warning in the middle of a line), and a message said before is not repeated.
+  struct Said {
+    std::mutex lock;
+    std::set<std::string> messages;
+  };
+  auto said = std::make_shared<Said>();
+  return [said](const std::string& message) {
+    const std::lock_guard<std::mutex> hold(said->lock);
+    if (!said->messages.insert(message).second) return;
+    std::cout.flush();
+    std::fflush(stdout);
+    std::cerr << "warning: " << message << "\n";
+    std::cerr.flush();
+  };
 }
 
 namespace io_detail {

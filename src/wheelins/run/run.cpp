@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <set>
 
 #include "wheelins/run/input_checks.hpp"
@@ -33,6 +34,34 @@ const char* extension(TrajectoryFormat f) {
   }
 }
 bool multi(const RunRequest& r) { return r.modules.size() > 1 && r.write_subsystems; }
+
+/// Which records of one stream go to its files (RunRequest::file_interval): the first at or
+/// after each step of the interval from the first record, and the last one (held back until
+/// the end). No allocation: one record is held.
+class FileThinning {
+ public:
+  explicit FileThinning(double interval) : interval_(interval) {}
+  /// True: write `rec` now; false: it is passed over (and held, in case it is the last).
+  bool keep(const TrajectoryRecord& rec) {
+    if (interval_ <= 0.0) return true;
+    if (started_ && rec.t + 1e-9 < next_) {
+      held_ = rec;
+      return false;
+    }
+    if (!started_) next_ = rec.t, started_ = true;
+    while (next_ <= rec.t + 1e-9) next_ += interval_;
+    held_.reset();
+    return true;
+  }
+  /// The stream's last record if it was passed over.
+  const std::optional<TrajectoryRecord>& held() const { return held_; }
+
+ private:
+  double interval_;
+  double next_ = 0.0;
+  bool started_ = false;
+  std::optional<TrajectoryRecord> held_;
+};
 /// weights.csv: a run of several modules with the position constraint.
 bool writes_weights(const RunRequest& r) {
   return r.modules.size() > 1 && r.nav.fusion.position_constraint;
@@ -84,6 +113,9 @@ void validate_run_request(const RunRequest& r) {
   if (!(n.output_interval >= 0.0 && n.output_interval <= 5.0))
     throw InputError("output interval: must be in [0, 5] s (0 = every epoch; the evaluation "
                      "interpolates across at most 5 s), got " + format_double(n.output_interval));
+  if (!(r.file_interval >= 0.0 && r.file_interval <= 5.0))
+    throw InputError("file interval (output.file_interval_s): must be in [0, 5] s (0 = every "
+                     "record), got " + format_double(r.file_interval));
   n.validate();  // the navigator's own ranges (the covariance interval, the update intervals)
   if (n.fusion.centralized && r.modules.size() < 2)
     throw InputError("the centralized filter joins several IMUs; a run of one module ('" +
@@ -230,6 +262,7 @@ RunResult run_navigation(const RunRequest& r) {
     });
   NavigatorOptions nav_opt = r.nav;
   nav_opt.module_records = !subsystems.empty();  // only when their files are written
+  std::vector<FileThinning> thinning(1 + subsystems.size(), FileThinning(r.file_interval));
   // What the records are used for (the caller's consumer, e.g. the streaming evaluation,
   // and the hand-over to the writer thread, which waits when the writer is behind) is
   // timed here and left out of filter_seconds. A record that is not finite is never
@@ -246,7 +279,7 @@ RunResult run_navigation(const RunRequest& r) {
     }
     const auto t0 = std::chrono::steady_clock::now();
     if (stream == 0 && r.on_record) r.on_record(rec);
-    if (pipe) pipe->push(stream, rec);
+    if (pipe && thinning[static_cast<std::size_t>(stream)].keep(rec)) pipe->push(stream, rec);
     sink_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   });
   // Where the solution stopped being finite: the first subsystem whose state or covariance
@@ -326,7 +359,11 @@ RunResult run_navigation(const RunRequest& r) {
   check_finite(nav.stats().t_end);
   if (r.warn)
     for (const auto& w : nav.faults().warnings()) r.warn(w);
-  if (pipe) pipe->finish();  // every record written (or the writer's error thrown)
+  if (pipe) {
+    for (std::size_t k = 0; k < thinning.size(); ++k)  // the files end where the run ended
+      if (thinning[k].held()) pipe->push(static_cast<int>(k), *thinning[k].held());
+    pipe->finish();  // every record written (or the writer's error thrown)
+  }
   RunResult result;
   for (auto& w : vehicle) w->commit();
   for (auto& w : subsystems) w->commit();

@@ -26,6 +26,10 @@ struct RunRequest {
   TumFrame tum_frame = TumFrame::kNed;
   bool overwrite = false;
   bool write_subsystems = true;      ///< also <module>.csv per subsystem (multi-IMU runs)
+  /// [s] between the records written to the trajectory files: the first record at or after
+  /// each step from the first, and always the last; 0: every record. on_record (the
+  /// evaluation) sees every record either way. The run configuration's default is 0.1 s.
+  double file_interval = 0.0;
   bool progress = true;              ///< a progress line on a terminal
   double max_duration = 0.0;         ///< stop after this much navigation [s]; 0 = all data
   /// The Wheel-IMUs' mounting and lever arm: estimated from the data in a first pass over

@@ -82,7 +82,8 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
 
   if (auto out = y.get(root, "output"); out.IsDefined()) {
     y.require_map(out, "output");
-    y.check_keys(out, "output", {"dir", "formats", "interval_s", "overwrite", "subsystems", "tum_frame"});
+    y.check_keys(out, "output",
+                 {"dir", "file_interval_s", "formats", "interval_s", "overwrite", "subsystems", "tum_frame"});
     if (auto v = y.get(out, "dir"); v.IsDefined()) c.output_dir = rel(y.text(v, "output.dir"));
     if (auto v = y.get(out, "formats"); v.IsDefined()) {
       c.formats.clear();
@@ -101,6 +102,9 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
       c.nav.output_interval = y.number_in(v, "output.interval_s", kRange.output_interval[0],
                                           kRange.output_interval[1], "s (0 = every epoch)");
     }
+    if (auto v = y.get(out, "file_interval_s"); v.IsDefined())
+      c.file_interval = y.number_in(v, "output.file_interval_s", kRange.output_interval[0],
+                                    kRange.output_interval[1], "s (0 = every record)");
     if (auto v = y.get(out, "overwrite"); v.IsDefined()) c.overwrite = y.boolean(v, "output.overwrite");
     if (auto v = y.get(out, "subsystems"); v.IsDefined())
       c.write_subsystems = y.boolean(v, "output.subsystems");
@@ -352,6 +356,7 @@ RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn) {
   r.tum_frame = cfg.tum_frame;
   r.overwrite = cfg.overwrite;
   r.write_subsystems = cfg.write_subsystems;
+  r.file_interval = cfg.file_interval;
   r.max_duration = cfg.max_duration;
   r.calibration = cfg.calibration;
   r.data_checks = cfg.data_checks;
