@@ -35,19 +35,31 @@ struct Dataset {
   }
 };
 
-/// 200 s of the default scenario (field profile, one chip per module), made once.
+/// 200 s of the default scenario (field profile, one chip per module) on the vehicle of
+/// `preset`, simulated into a scratch directory named by `tag`.
+std::unique_ptr<Dataset> simulate(const std::string& preset, const std::string& tag) {
+  auto ds = std::make_unique<Dataset>();
+  ds->dir = fs::temp_directory_path() /
+            ("wheelins-bench-" + tag + "-" + std::to_string(::getpid()));
+  sim::SimConfig cfg;
+  cfg.vehicle = sim::VehicleConfig::preset_named(preset);
+  cfg.chips = 1;
+  cfg.duration = 200.0;
+  cfg.write_ideal = false;
+  sim::Simulation(cfg).write(ds->dir, true, false);
+  ds->manifest = load_manifest(ds->dir / "manifest.yaml", {});
+  return ds;
+}
+
+/// The robot of the default scenario, made once.
 const Dataset& dataset() {
-  static const std::unique_ptr<Dataset> d = [] {
-    auto ds = std::make_unique<Dataset>();
-    ds->dir = fs::temp_directory_path() / ("wheelins-bench-" + std::to_string(::getpid()));
-    sim::SimConfig cfg;
-    cfg.chips = 1;
-    cfg.duration = 200.0;
-    cfg.write_ideal = false;
-    sim::Simulation(cfg).write(ds->dir, true, false);
-    ds->manifest = load_manifest(ds->dir / "manifest.yaml", {});
-    return ds;
-  }();
+  static const std::unique_ptr<Dataset> d = simulate("robot", "robot");
+  return *d;
+}
+
+/// The car with steered front Wheel-IMUs (preset car-steered): four hubs and a body, made once.
+const Dataset& steered_car() {
+  static const std::unique_ptr<Dataset> d = simulate("car-steered", "car-steered");
   return *d;
 }
 
@@ -57,8 +69,7 @@ struct Sample {
 };
 
 /// The merged, time-ordered samples of `modules`, read once.
-std::vector<Sample> samples_of(const std::vector<std::string>& modules) {
-  const Dataset& d = dataset();
+std::vector<Sample> samples_of(const Dataset& d, const std::vector<std::string>& modules) {
   std::vector<std::unique_ptr<ImuFileReader>> readers;
   for (const auto& name : modules) {
     const ModuleSpec& spec = *d.manifest.find(name);
@@ -74,8 +85,9 @@ std::vector<Sample> samples_of(const std::vector<std::string>& modules) {
 }
 
 void run_navigator(benchmark::State& state, const std::vector<std::string>& modules,
-                   bool centralized, bool turn_average = false) {
-  const std::vector<Sample> samples = samples_of(modules);
+                   bool centralized, bool turn_average = false,
+                   const Dataset& data = dataset()) {
+  const std::vector<Sample> samples = samples_of(data, modules);
   NavigatorOptions opt;
   opt.fusion.centralized = centralized;
   opt.wheel.turn_average = turn_average;
@@ -84,7 +96,7 @@ void run_navigator(benchmark::State& state, const std::vector<std::string>& modu
   double seconds = 0.0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
-    Navigator nav(dataset().manifest, modules, opt, [](int, const TrajectoryRecord&) {});
+    Navigator nav(data.manifest, modules, opt, [](int, const TrajectoryRecord&) {});
     for (const Sample& x : samples) nav.process(x.index, x.s);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     epochs += nav.stats().epochs;
@@ -112,6 +124,21 @@ void BM_EpochTripleCentralized(benchmark::State& state) {
   run_navigator(state, {"left-C1", "right-C1", "body-C1"}, true);
 }
 BENCHMARK(BM_EpochTripleCentralized)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Five IMUs (issue 37): the four hubs of the car with steered front wheels and its body; one
+// epoch is five samples.
+const std::vector<std::string> kFiveImus{"left-C1", "right-C1", "body-C1", "front-left-C1",
+                                         "front-right-C1"};
+
+void BM_EpochFiveImusDistributed(benchmark::State& state) {
+  run_navigator(state, kFiveImus, false, false, steered_car());
+}
+BENCHMARK(BM_EpochFiveImusDistributed)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_EpochFiveImusCentralized(benchmark::State& state) {
+  run_navigator(state, kFiveImus, true, false, steered_car());
+}
+BENCHMARK(BM_EpochFiveImusCentralized)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 Mat21 spd_covariance() {
   Mat21 A = Mat21::Random() * 0.01;
