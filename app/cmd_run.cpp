@@ -122,57 +122,49 @@ void print_run_summary(const RunRequest& req, const RunResult& res) {
   std::cout << ")\n";
 }
 
+/// The command line's settings over the run configuration (run/run_config.hpp: RunOverrides,
+/// applied as Python's run() applies its keywords).
+RunOverrides overrides_of(const RunArgs& a) {
+  RunOverrides o;
+  o.config = a.config_file;
+  o.manifest = a.manifest;
+  o.configuration = a.configuration;
+  if (!a.chips.empty()) o.chips = cli::split_list(a.chips);
+  if (!a.modules.empty()) {
+    o.modules = cli::split_list(a.modules);
+    if (o.modules.empty()) throw InputError("--modules '" + a.modules + "': no module named");
+  }
+  o.output_dir = a.out;
+  if (!a.formats.empty()) o.formats = cli::split_list(a.formats);
+  o.tum_frame = a.tum_frame;
+  o.speed = a.speed;
+  o.weights = a.weights;
+  o.yaw_scale_factors = a.yaw;
+  o.calibration = a.calibration;
+  auto flag = [](bool set, bool value) { return set ? std::optional<bool>(value) : std::nullopt; };
+  o.centralized = flag(a.centralized, true);
+  o.position_constraint = flag(a.no_constraint, false);
+  o.fault_handling = flag(a.no_faults, false);
+  o.standstill = flag(a.no_standstill, false);
+  o.fixed_noise = flag(a.fixed_noise, true);
+  o.data_checks = flag(a.no_data_checks, false);
+  o.duration = a.duration;
+  o.output_interval = a.output_interval;
+  o.covariance_interval = a.covariance_interval;
+  o.overwrite = a.force;
+  o.full_rate = a.full_rate;
+  o.subsystems = a.subsystems;
+  return o;
+}
+
 int run(const RunArgs& a) {
   check_range(a.duration, "--duration", 0.0, 1e7, "s", true);
   check_range(a.output_interval, "--output-interval", 0.0, 5.0, "s (0 = every epoch)");
   check_range(a.covariance_interval, "--covariance-interval", 0.0,
               NavigatorOptions::kMaxCovarianceInterval, "s (0 = every epoch)");
-  if (!a.modules.empty() && !a.configuration.empty())
-    throw InputError("--modules and --configuration both given: --modules names the IMUs "
-                     "itself; give one of them");
-  if (!a.modules.empty() && !a.chips.empty())
-    throw InputError("--modules and --chips both given: --chips picks the chips of a "
-                     "--configuration; with --modules name the chips' modules (e.g. left-C2)");
-  RunConfig cfg = a.config_file.empty() ? RunConfig{} : load_run_config(a.config_file, stderr_sink());
-  if (!a.manifest.empty()) cfg.manifest = a.manifest;
-  if (cfg.manifest.empty())
-    throw InputError("no dataset: give a run config (wheelins run CONFIG.yaml) or --manifest FILE");
-  if (!a.configuration.empty()) {
-    cfg.configuration = a.configuration;
-    cfg.modules.clear();  // the command line's choice over the config file's modules
-  }
-  if (!a.chips.empty()) cfg.chips = cli::split_list(a.chips);
-  if (!a.modules.empty()) {
-    cfg.modules = cli::split_list(a.modules);
-    if (cfg.modules.empty()) throw InputError("--modules '" + a.modules + "': no module named");
-  }
-  if (!a.out.empty()) cfg.output_dir = a.out;
-  if (!a.formats.empty()) {
-    cfg.formats.clear();
-    for (const auto& f : cli::split_list(a.formats)) cfg.formats.push_back(trajectory_format_from_name(f));
-  }
-  if (!a.tum_frame.empty()) cfg.tum_frame = tum_frame_from_name(a.tum_frame);
-  if (!a.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(a.speed);
-  if (!a.yaw.empty()) cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(a.yaw);
-  if (!a.weights.empty()) {
-    cfg.nav.fusion.weighting = weighting_from_name(a.weights);
-    cfg.nav.fusion.weights.clear();  // the command line overrides the configuration's list
-  }
-  if (!a.calibration.empty()) cfg.calibration = calibration_mode_from_name(a.calibration);
-  if (a.centralized) cfg.nav.fusion.centralized = true;
-  if (a.no_constraint) cfg.nav.fusion.position_constraint = false;
-  if (a.force) cfg.overwrite = true;
-  if (a.duration) cfg.max_duration = *a.duration;
-  if (a.no_faults) cfg.nav.faults.enabled = false;
-  if (a.no_standstill) cfg.nav.standstill.enabled = false;
-  if (a.no_data_checks) cfg.data_checks = false;
-  if (a.fixed_noise) cfg.nav.noise.enabled = false;
-  if (a.output_interval) cfg.nav.output_interval = *a.output_interval;
-  if (a.covariance_interval) cfg.nav.covariance_interval = *a.covariance_interval;
-  if (a.full_rate) cfg.file_interval = 0.0;
-  if (a.subsystems) cfg.write_subsystems = true;
-
-  RunRequest req = make_run_request(cfg, stderr_sink());
+  const WarningSink warn = stderr_sink();  // one sink: each warning once
+  const RunConfig cfg = run_config_with(overrides_of(a), warn);
+  RunRequest req = make_run_request(cfg, warn);
   req.progress = !a.quiet;
 
   // Evaluation against the truth as the run goes (eval/run_evaluation.hpp): a truth file

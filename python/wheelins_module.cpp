@@ -184,60 +184,35 @@ auto interruptible(F&& f) -> decltype(f()) {
   return std::move(*result);
 }
 
-/// What `wheelins run` takes besides the files, with its option names.
-struct Settings {
-  std::string configuration, config, speed, weights;
-  std::vector<std::string> chips, modules, formats;
-  std::optional<bool> centralized, position_constraint, fault_handling, fixed_noise;
-  std::optional<double> duration, output_interval, covariance_interval;
-  std::string yaw_scale_factors;
-  std::string calibration;  ///< "" = the configuration's (estimate by default)
-};
-
-/// The run configuration as `wheelins run` builds it from a config file and its flags.
-RunConfig run_config(const std::string& manifest, const Settings& s) {
-  RunConfig cfg = s.config.empty() ? RunConfig{} : load_run_config(s.config, stderr_sink());
-  if (!manifest.empty()) cfg.manifest = manifest;
-  if (cfg.manifest.empty())
-    throw InputError("no dataset: give a manifest (or a run configuration naming one)");
-  // As wheelins run: the two ways of choosing the IMUs exclude each other.
-  if (!s.modules.empty() && !s.configuration.empty())
-    throw InputError("modules and configuration both given: modules names the IMUs itself; give one of them");
-  if (!s.modules.empty() && !s.chips.empty())
-    throw InputError("modules and chips both given: chips picks the chips of a configuration; with modules "
-                     "name the chips' modules (e.g. left-C2)");
-  if (!s.configuration.empty()) {
-    cfg.configuration = s.configuration;
-    cfg.modules.clear();  // the call's choice over the config file's modules
-  }
-  if (!s.chips.empty()) cfg.chips = s.chips;
-  if (!s.modules.empty()) cfg.modules = s.modules;
-  if (!s.formats.empty()) {
-    cfg.formats.clear();
-    for (const auto& f : s.formats) cfg.formats.push_back(trajectory_format_from_name(f));
-  }
-  if (!s.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(s.speed);
-  if (!s.yaw_scale_factors.empty())
-    cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(s.yaw_scale_factors);
-  if (!s.calibration.empty()) cfg.calibration = calibration_mode_from_name(s.calibration);
-  if (!s.weights.empty()) {
-    cfg.nav.fusion.weighting = weighting_from_name(s.weights);
-    cfg.nav.fusion.weights.clear();  // as wheelins run --weights: over the config's list
-  }
-  if (s.fixed_noise) cfg.nav.noise.enabled = !*s.fixed_noise;
-  if (s.centralized) cfg.nav.fusion.centralized = *s.centralized;
-  if (s.position_constraint) cfg.nav.fusion.position_constraint = *s.position_constraint;
-  if (s.fault_handling) cfg.nav.faults.enabled = *s.fault_handling;
-  // Ranges (NaN included) are checked with the request (validate_run_request).
-  if (s.duration) cfg.max_duration = *s.duration;
-  if (s.output_interval) cfg.nav.output_interval = *s.output_interval;
-  if (s.covariance_interval) cfg.nav.covariance_interval = *s.covariance_interval;
-  return cfg;
-}
-
 std::optional<std::string> text(const py::object& o) {
   if (o.is_none()) return std::nullopt;
   return py::str(py::module_::import("os").attr("fspath")(o)).cast<std::string>();
+}
+
+/// The settings run() and Navigator() share, as `wheelins run` takes them (its options by name).
+RunOverrides shared_settings(const py::object& manifest, const std::string& configuration,
+                             const std::vector<std::string>& chips, const std::vector<std::string>& modules,
+                             const py::object& config, const std::string& speed, std::optional<bool> centralized,
+                             std::optional<bool> position_constraint, std::optional<bool> fault_handling,
+                             std::optional<double> duration, std::optional<double> output_interval,
+                             std::optional<double> covariance_interval, const std::string& yaw_scale_factors,
+                             const std::string& calibration) {
+  RunOverrides s;
+  s.config = text(config).value_or("");
+  s.manifest = text(manifest).value_or("");
+  s.configuration = configuration;
+  s.chips = chips;
+  s.modules = modules;
+  s.speed = speed;
+  s.yaw_scale_factors = yaw_scale_factors;
+  s.calibration = calibration;
+  s.centralized = centralized;
+  s.position_constraint = position_constraint;
+  s.fault_handling = fault_handling;
+  s.duration = duration;
+  s.output_interval = output_interval;
+  s.covariance_interval = covariance_interval;
+  return s;
 }
 
 // ----------------------------------------------------------------------------- run
@@ -267,15 +242,18 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
               std::optional<bool> fixed_noise, const std::string& yaw_scale_factors,
               const std::string& calibration, bool force, bool progress, bool full_rate,
               bool subsystems) {
-  Settings s{configuration, text(config).value_or(""), speed, weights, chips, modules, formats,
-             centralized, position_constraint, fault_handling, fixed_noise, duration, output_interval,
-             covariance_interval, yaw_scale_factors, calibration};
-  RunConfig cfg = run_config(text(manifest).value_or(""), s);
-  if (force) cfg.overwrite = true;
-  if (full_rate) cfg.file_interval = 0.0;  // as wheelins run --full-rate
-  if (subsystems) cfg.write_subsystems = true;
+  RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
+                                   position_constraint, fault_handling, duration, output_interval,
+                                   covariance_interval, yaw_scale_factors, calibration);
+  s.formats = formats;
+  s.weights = weights;
+  s.fixed_noise = fixed_noise;
+  s.overwrite = force;
+  s.full_rate = full_rate;
+  s.subsystems = subsystems;
+  const WarningSink warn = stderr_sink();
   const std::optional<std::string> out_dir = text(out);
-  RunRequest req = make_run_request(cfg, stderr_sink());
+  RunRequest req = make_run_request(run_config_with(s, warn), warn);
   req.output_dir = out_dir ? std::filesystem::path(*out_dir) : std::filesystem::path();  // none: nothing written
   req.progress = progress;
   RunOutput o;
@@ -422,10 +400,12 @@ class StreamNavigator {
     // (a calibrated manifest comes from `wheelins calibrate`). "estimate": the installation
     // geometry estimated from the first `calibration_warmup` seconds after the static period,
     // whose samples are kept and navigated when it ends (docs/python.md).
-    Settings s{configuration, text(config).value_or(""), speed, "", chips, modules, {},
-               centralized, position_constraint, fault_handling, std::nullopt, duration, output_interval,
-               covariance_interval, yaw_scale_factors, calibration.empty() ? "manifest" : calibration};
-    req_ = make_run_request(run_config(text(manifest).value_or(""), s), stderr_sink());
+    const RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
+                                           position_constraint, fault_handling, duration, output_interval,
+                                           covariance_interval, yaw_scale_factors,
+                                           calibration.empty() ? "manifest" : calibration);
+    const WarningSink warn = stderr_sink();
+    req_ = make_run_request(run_config_with(s, warn), warn);
     if (req_.calibration == CalibrationMode::kEstimate) {
       if (!(calibration_warmup > 0.0) || !std::isfinite(calibration_warmup))
         throw InputError("calibration_warmup must be a positive number of seconds (given " +

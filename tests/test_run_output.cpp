@@ -12,6 +12,7 @@
 #include "io_test_util.hpp"
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/trajectory.hpp"
+#include "wheelins/run/run_config.hpp"
 
 using namespace wheelins;
 using namespace wheelins::dstest;
@@ -129,6 +130,43 @@ TEST(WarningSinkTest, StderrSinkSaysEachWarningOnceAsAWholeLine) {
   warn("left-C1: something");
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_EQ(err, "warning: left-C1: something\nwarning: right-C1: something else\n");
+}
+
+}  // namespace
+
+namespace {
+
+// One function applies the command line's flags and Python's keywords over a run configuration.
+TEST_F(RunOutput, OverridesApplyOverTheConfigurationFile) {
+  iotest::write_text(dir_->path() / "cfg.yaml",
+                     "dataset: ds/manifest.yaml\nconfiguration: dual-wheel\nmodules: [left-C1]\n"
+                     "output:\n  file_interval_s: 0.5\n  subsystems: false\n"
+                     "fusion:\n  weights: [0.5, 0.5]\n");
+  RunOverrides o;
+  o.config = dir_->path() / "cfg.yaml";
+  RunConfig c = run_config_with(o, {});
+  EXPECT_EQ(c.modules, std::vector<std::string>{"left-C1"});
+  EXPECT_DOUBLE_EQ(c.file_interval, 0.5);
+  EXPECT_EQ(c.nav.fusion.weights.size(), 2u);
+
+  o.configuration = "triple";  // over the file's configuration and its module list
+  o.weights = "covariance";    // over the file's fixed weights
+  o.full_rate = true;
+  o.subsystems = true;
+  o.fixed_noise = true;
+  c = run_config_with(o, {});
+  EXPECT_EQ(c.configuration, "triple");
+  EXPECT_TRUE(c.modules.empty());
+  EXPECT_TRUE(c.nav.fusion.weights.empty());
+  EXPECT_EQ(c.nav.fusion.weighting, ReferenceWeighting::kCovariance);
+  EXPECT_DOUBLE_EQ(c.file_interval, 0.0);
+  EXPECT_TRUE(c.write_subsystems);
+  EXPECT_FALSE(c.nav.noise.enabled);
+
+  o.modules = {"left-C1"};  // both ways of choosing the IMUs: an error
+  EXPECT_THROW(run_config_with(o, {}), InputError);
+  RunOverrides none;
+  EXPECT_THROW(run_config_with(none, {}), InputError);  // no dataset
 }
 
 }  // namespace

@@ -338,6 +338,51 @@ RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   return c;
 }
 
+RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
+  RunConfig cfg = o.config.empty() ? RunConfig{} : load_run_config(o.config, warn);
+  if (!o.manifest.empty()) cfg.manifest = o.manifest;
+  if (cfg.manifest.empty())
+    throw InputError("no dataset: give a run configuration naming one, or a manifest (--manifest)");
+  if (!o.modules.empty() && !o.configuration.empty())
+    throw InputError("modules and configuration both given: the modules name the IMUs themselves; "
+                     "give one of them");
+  if (!o.modules.empty() && !o.chips.empty())
+    throw InputError("modules and chips both given: chips pick the chips of a configuration; with "
+                     "modules name the chips' modules (e.g. left-C2)");
+  if (!o.configuration.empty()) {
+    cfg.configuration = o.configuration;
+    cfg.modules.clear();  // the front end's choice over the configuration file's modules
+  }
+  if (!o.chips.empty()) cfg.chips = o.chips;
+  if (!o.modules.empty()) cfg.modules = o.modules;
+  if (!o.output_dir.empty()) cfg.output_dir = o.output_dir;
+  if (!o.formats.empty()) {
+    cfg.formats.clear();
+    for (const auto& f : o.formats) cfg.formats.push_back(trajectory_format_from_name(f));
+  }
+  if (!o.tum_frame.empty()) cfg.tum_frame = tum_frame_from_name(o.tum_frame);
+  if (!o.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(o.speed);
+  if (!o.yaw_scale_factors.empty()) cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(o.yaw_scale_factors);
+  if (!o.weights.empty()) {
+    cfg.nav.fusion.weighting = weighting_from_name(o.weights);
+    cfg.nav.fusion.weights.clear();  // over the configuration's list of fixed weights
+  }
+  if (!o.calibration.empty()) cfg.calibration = calibration_mode_from_name(o.calibration);
+  if (o.centralized) cfg.nav.fusion.centralized = *o.centralized;
+  if (o.position_constraint) cfg.nav.fusion.position_constraint = *o.position_constraint;
+  if (o.fault_handling) cfg.nav.faults.enabled = *o.fault_handling;
+  if (o.standstill) cfg.nav.standstill.enabled = *o.standstill;
+  if (o.fixed_noise) cfg.nav.noise.enabled = !*o.fixed_noise;
+  if (o.data_checks) cfg.data_checks = *o.data_checks;
+  if (o.duration) cfg.max_duration = *o.duration;
+  if (o.output_interval) cfg.nav.output_interval = *o.output_interval;
+  if (o.covariance_interval) cfg.nav.covariance_interval = *o.covariance_interval;
+  if (o.overwrite) cfg.overwrite = true;
+  if (o.full_rate) cfg.file_interval = 0.0;
+  if (o.subsystems) cfg.write_subsystems = true;
+  return cfg;
+}
+
 RunRequest make_run_request(const RunConfig& cfg, const WarningSink& warn) {
   RunRequest r;
   r.manifest = load_manifest(cfg.manifest, warn);

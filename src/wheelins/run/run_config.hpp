@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,29 @@ struct RunConfig {
 
 /// Reads a run configuration; relative paths resolve against the file's directory.
 RunConfig load_run_config(const std::filesystem::path& file, const WarningSink& warn);
+
+/// What a front end (`wheelins run`'s flags, Python's run() and Navigator()) sets over a run
+/// configuration, each setting once: an empty or unset field keeps the configuration's value.
+/// The numbers' ranges are checked with the request (validate_run_request).
+struct RunOverrides {
+  std::filesystem::path config;    ///< a run configuration file; empty: the defaults
+  std::filesystem::path manifest;  ///< over the configuration's dataset
+  std::string configuration;       ///< over the configuration's (and its module list)
+  std::vector<std::string> chips, modules;
+  std::filesystem::path output_dir;
+  std::vector<std::string> formats;
+  std::string tum_frame, speed, weights, yaw_scale_factors, calibration;
+  std::optional<bool> centralized, position_constraint, fault_handling, standstill, fixed_noise,
+      data_checks;
+  std::optional<double> duration, output_interval, covariance_interval;
+  bool overwrite = false;   ///< --force
+  bool full_rate = false;   ///< the trajectory files at every record
+  bool subsystems = false;  ///< also each IMU's own trajectory
+};
+
+/// The configuration file's settings (or the defaults) with `o` over them; InputError for
+/// choices that exclude each other (modules with a configuration or chips) and for no dataset.
+RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn);
 
 SpeedSharing speed_sharing_from_name(const std::string& name);
 /// `auto`, `held`, `constraint` or `estimated` (docs/filter.md 13.4); InputError otherwise.
