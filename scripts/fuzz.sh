@@ -7,7 +7,10 @@ set -euo pipefail
 seconds=${1:-60}
 build=${2:-build-fuzz}
 cd "$(dirname "$0")/.."
+# -O1 -g1 (line tables), as the sanitizer suite: libFuzzer's documentation builds its targets
+# at -O1 or -O2; -O1 compiles the library in about a third less time.
 CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_FUZZ=ON \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
   -DWHEELINS_BUILD_TESTS=OFF -DWHEELINS_BUILD_BENCH=OFF > /dev/null
 cmake --build "$build" -j"$(nproc)" --target fuzz_imu_file fuzz_truth fuzz_truth_text fuzz_config fuzz_mcap fuzz_ros1 fuzz_table
 for target in imu_file truth truth_text config mcap ros1 table; do
