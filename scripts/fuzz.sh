@@ -7,8 +7,8 @@ set -euo pipefail
 seconds=${1:-60}
 build=${2:-build-fuzz}
 cd "$(dirname "$0")/.."
-# -O1 -g1 (line tables), as the sanitizer suite: libFuzzer's documentation builds its targets
-# at -O1 or -O2; -O1 compiles the library in about a third less time.
+# -O1 -g1 (line tables), as the sanitizer suite (libFuzzer's documentation builds its targets
+# at -O1 or -O2). In CI the build still takes about 7 minutes of the fuzzing step's 8.5.
 CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_FUZZ=ON \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
   -DWHEELINS_BUILD_TESTS=OFF -DWHEELINS_BUILD_BENCH=OFF > /dev/null
