@@ -116,9 +116,14 @@ void print_run_summary(const RunRequest& req, const RunResult& res) {
             << res.files.front().parent_path().string() << " (";
   for (std::size_t i = 0; i < res.files.size(); ++i)
     std::cout << (i ? ", " : "") << res.files[i].filename().string();
-  if (req.file_interval > 0)
-    std::printf("; trajectories every %g s: --full-rate for every epoch", req.file_interval);
-  if (req.modules.size() > 1 && !req.write_subsystems) std::cout << ", --subsystems for each IMU's";
+  // What more the flags would write: every record (when records are passed over), and each
+  // IMU's own trajectory.
+  const char* sep = "; ";
+  if (req.file_interval > req.nav.output_interval) {
+    std::printf("%sthe trajectory every %g s: --full-rate for every record", sep, req.file_interval);
+    sep = ", ";
+  }
+  if (req.modules.size() > 1 && !req.write_subsystems) std::cout << sep << "--subsystems for each IMU's";
   std::cout << ")\n";
 }
 
