@@ -58,7 +58,10 @@ ChipModel draw_chip(const SimConfig& cfg, const std::string& name) {
   ch.name = name;
   auto draw3 = [&](const std::string& stream, double sigma) {
     Rng r(cfg.seed, ch.name + "/" + stream);
-    return Vec3(r.normal(sigma), r.normal(sigma), r.normal(sigma));
+    // The draws in a fixed order (z, y, x: the order the simulator's data were first made
+    // in), not as a constructor's arguments, whose order of evaluation the compiler chooses.
+    const double z = r.normal(sigma), y = r.normal(sigma), x = r.normal(sigma);
+    return Vec3(x, y, z);
   };
   auto draw_T = [&](const std::string& stream, double sf, double mis, bool sf_on, bool mis_on) {
     Rng r(cfg.seed, ch.name + "/" + stream);
