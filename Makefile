@@ -12,8 +12,12 @@ all: build
 setup:
 	@scripts/setup.sh
 
+# Ninja for a new build directory: the targets of `make test` build as one graph, both cores
+# busy to the end (a directory configured before keeps its generator).
+GENERATOR := $(if $(wildcard $(BUILD)/CMakeCache.txt),,-G Ninja)
+
 configure: setup
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DWHEELINS_WERROR=$(WHEELINS_WERROR) >/dev/null
+	@cmake -S . -B $(BUILD) $(GENERATOR) -DCMAKE_BUILD_TYPE=Release -DWHEELINS_WERROR=$(WHEELINS_WERROR) >/dev/null
 
 build: configure
 	@cmake --build $(BUILD) -j$(JOBS)

@@ -7,12 +7,19 @@ set -euo pipefail
 seconds=${1:-60}
 build=${2:-build-fuzz}
 cd "$(dirname "$0")/.."
-# -O1 -g1 (line tables), as the sanitizer suite (libFuzzer's documentation builds its targets
-# at -O1 or -O2). In CI the build still takes about 7 minutes of the fuzzing step's 8.5.
-CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_FUZZ=ON \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-  -DWHEELINS_BUILD_TESTS=OFF -DWHEELINS_BUILD_BENCH=OFF > /dev/null
-cmake --build "$build" -j"$(nproc)" --target fuzz_imu_file fuzz_truth fuzz_truth_text fuzz_config fuzz_mcap fuzz_ros1 fuzz_table
+targets=(fuzz_imu_file fuzz_truth fuzz_truth_text fuzz_config fuzz_mcap fuzz_ros1 fuzz_table)
+# A build directory configured for fuzzing already (scripts/sanitize-test.sh's, with the tests)
+# is used as it is: only the targets' own sources are left to build.
+if ! grep -q '^WHEELINS_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
+  # -O1 -g1 (line tables), as the sanitizer suite (libFuzzer's documentation builds its
+  # targets at -O1 or -O2).
+  generator=()
+  [ -f "$build/CMakeCache.txt" ] || generator=(-G Ninja)
+  CXX=clang++ cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DWHEELINS_FUZZ=ON -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+    -DWHEELINS_BUILD_TESTS=OFF -DWHEELINS_BUILD_BENCH=OFF > /dev/null
+fi
+cmake --build "$build" -j"$(nproc)" --target "${targets[@]}"
 for target in imu_file truth truth_text config mcap ros1 table; do
   corpus_seed="fuzz/corpus/${target%_file}"
   work="$build/corpus-$target"

@@ -1,18 +1,24 @@
 #!/usr/bin/env bash
-# Builds the test suite with AddressSanitizer + UndefinedBehaviorSanitizer (gcc)
-# and runs it; any sanitizer report fails a test and so this script.
+# Builds the test suite with AddressSanitizer + UndefinedBehaviorSanitizer (clang) and runs
+# it; any sanitizer report fails a test and so this script. The same build holds the
+# libFuzzer targets (WHEELINS_FUZZ): `scripts/fuzz.sh SECONDS BUILD_DIR` then builds only
+# their seven small sources (CI: this script, then fuzz.sh on the same directory).
 # Usage: scripts/sanitize-test.sh [BUILD_DIR]
 set -euo pipefail
 build=${1:-build-asan}
 cd "$(dirname "$0")/.."
+scripts/setup.sh fuzz  # clang and its sanitizer/libFuzzer runtime
 # -O1 -g1 (line tables): the optimisation level the sanitizers' documentation suggests, and
 # a third less compile time than -O2 -g on the fixed-size joint covariances.
 # Built without ROS 1 (WHEELINS_ROS1=OFF): CI so builds and tests the ROS-free configuration
 # too; the tests that write ROS 1 bags through Debian's ROS libraries run in `make test`.
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWHEELINS_WERROR=ON -DWHEELINS_ROS1=OFF \
-  -DWHEELINS_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-  -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
-  > /dev/null
+# Built by clang (make test builds with gcc): two compilers' warnings, as errors, and their
+# sanitizers.
+generator=()
+[ -f "$build/CMakeCache.txt" ] || generator=(-G Ninja)
+CXX=clang++ cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DWHEELINS_WERROR=ON -DWHEELINS_ROS1=OFF -DWHEELINS_BUILD_BENCH=OFF -DWHEELINS_FUZZ=ON \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" > /dev/null
 cmake --build "$build" -j"$(nproc)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

@@ -12,8 +12,6 @@
 namespace wheelins::survey {
 namespace {
 
-constexpr const char* kTodo = "TODO: measure";
-
 /// x rounded to a multiple of q (the precision the data give: the manifest stays readable).
 double round_to(double x, double q) {
   // Through text, so that the manifest shows the short number (not 847.8530000000001).
