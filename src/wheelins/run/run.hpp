@@ -61,8 +61,9 @@ struct RunResult {
   std::string calibration_report;            ///< readable table of them (empty: not estimated)
 };
 
-/// Runs the request. The output directory is written through OutputDir: checked, locked
-/// and staged before any work, its files appear together at the end (or not at all).
+/// Runs the request on the manifest's files (a RunSession fed by them, session.hpp). The
+/// output directory is written through OutputDir: checked, locked and staged before any
+/// work, its files appear together at the end (or not at all).
 RunResult run_navigation(const RunRequest& request);
 
 /// The checks of a request before any work (InputError naming what is wrong): modules
@@ -75,7 +76,13 @@ void validate_run_request(const RunRequest& request);
 std::vector<std::string> check_manifest_against_data(const Manifest& manifest, const std::vector<std::string>& modules,
                                                      const WarningSink& warn);
 
-/// The files a run would write (to refuse early, before any work, if they exist).
+/// A run of several modules writes <module>.csv per module (RunRequest::write_subsystems),
+/// and weights.csv when it has the position constraint.
+bool writes_subsystem_files(const RunRequest& request);
+bool writes_weights_file(const RunRequest& request);
+
+/// The files a run would write (to refuse early, before any work, if they exist): the
+/// trajectory in each of the request's formats first, in their order.
 std::vector<std::filesystem::path> run_output_files(const RunRequest& request);
 
 }  // namespace wheelins
