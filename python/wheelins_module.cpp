@@ -28,6 +28,7 @@
 #include "wheelins/run/calibration.hpp"
 #include "wheelins/run/input_checks.hpp"
 #include "wheelins/run/presets.hpp"
+#include "wheelins/run/push_session.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
 #include "wheelins/run/noise_report.hpp"
@@ -382,11 +383,9 @@ py::dict simulate(const py::object& out, const std::vector<std::string>& setting
 
 // ---------------------------------------------------------------------- navigator
 
-/// A run fed sample by sample: the request `wheelins run` makes (without files, validated
-/// as run_navigation() validates it), the samples made from the pushed records by
-/// io/imu_file.hpp imu_sample() as the file reader makes them and passed through the run's
-/// input checks (run/input_checks.hpp), the duration limit applied as run_navigation()
-/// applies it.
+/// A run fed sample by sample (run/push_session.hpp): the request `wheelins run` makes,
+/// without files, the pushed records made into samples as the file reader makes them and
+/// passed through the run's input checks, then the RunSession every run goes through.
 class StreamNavigator {
  public:
   StreamNavigator(const py::object& manifest, const std::string& configuration, const std::vector<std::string>& chips,
@@ -405,145 +404,45 @@ class StreamNavigator {
                                            covariance_interval, yaw_scale_factors,
                                            calibration.empty() ? "manifest" : calibration);
     const WarningSink warn = stderr_sink();
-    req_ = make_run_request(run_config_with(s, warn), warn);
-    if (req_.calibration == CalibrationMode::kEstimate) {
-      if (!(calibration_warmup > 0.0) || !std::isfinite(calibration_warmup))
-        throw InputError("calibration_warmup must be a positive number of seconds (given " +
-                         io_detail::format_double(calibration_warmup) + ")");
-      // As a run with a duration: the estimates from no sample past it.
-      const double w = req_.max_duration > 0.0 ? std::min(calibration_warmup, req_.max_duration) : calibration_warmup;
-      warmup_ = std::make_unique<CalibrationWarmup>(req_.manifest, req_.modules, req_.calibration_options, w);
-    }
-    req_.output_dir.clear();
-    validate_run_request(req_);
-    tracks_.reserve(req_.modules.size());  // (InputChecks keeps a reference to its spec)
-    for (const auto& name : req_.modules) {
-      const ModuleSpec* spec = req_.manifest.find(name);
-      tracks_.push_back(Track{imu_read_options(*spec), 0.0, 0,
-                              InputChecks(*spec, req_.manifest, req_.nav.faults.enabled, stderr_sink(),
-                                          "module '" + name + "' (pushed samples)")});
-    }
-    // Built now in any case, so that every setting is checked here; with a warm-up it is built
-    // again, on the estimates, when the warm-up ends.
-    make_navigator(req_.manifest);
-  }
-
-  /// The navigator, on the manifest (refined by the warm-up's estimates, if any).
-  void make_navigator(const Manifest& manifest) {
-    NavigatorOptions nav = req_.nav;
-    nav.module_records = false;  // as a run that writes no subsystem files
-    nav_ = std::make_unique<Navigator>(manifest, req_.modules, nav, [this](int stream, const TrajectoryRecord& r) {
-      if (stream != 0 || non_finite_) return;
-      // As the run driver: a record that is not finite is never passed on.
-      if (!(std::isfinite(r.t) && r.p_inN.allFinite() && r.v_inN.allFinite() && r.rpy.allFinite() &&
-            r.p_std.allFinite() && r.v_std.allFinite() && r.rpy_std.allFinite())) {
-        non_finite_ = true;
-        non_finite_t_ = r.t;
-        return;
-      }
-      records_.push_back(r);
-    });
+    RunRequest req = make_run_request(run_config_with(s, warn), warn);
+    req.output_dir.clear();
+    req.on_record = [this](const TrajectoryRecord& r) { records_.push_back(r); };
+    run_ = std::make_unique<PushSession>(std::move(req), calibration_warmup);
   }
 
   int index_of(const py::object& module) const {
+    const std::vector<std::string>& names = run_->request().modules;
     if (py::isinstance<py::int_>(module)) {
       const int i = module.cast<int>();
-      if (i < 0 || i >= static_cast<int>(req_.modules.size()))
+      if (i < 0 || i >= static_cast<int>(names.size()))
         throw InputError("module index " + std::to_string(i) + " out of range (0.." +
-                         std::to_string(req_.modules.size() - 1) + ")");
+                         std::to_string(names.size() - 1) + ")");
       return i;
     }
     const std::string name = module.cast<std::string>();
-    for (std::size_t i = 0; i < req_.modules.size(); ++i)
-      if (req_.modules[i] == name) return static_cast<int>(i);
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return static_cast<int>(i);
     std::string list;
-    for (const auto& m : req_.modules) list += (list.empty() ? "" : ", ") + m;
+    for (const auto& m : names) list += (list.empty() ? "" : ", ") + m;
     throw InputError("module '" + name + "' is not navigated (modules: " + list + ")");
   }
 
   /// One record of module `module` as its file holds it; false once the duration is reached.
   bool push(const py::object& module, double t, const std::array<double, 3>& gyro, const std::array<double, 3>& accel) {
-    if (finished_) throw InputError("push after finish()");
-    if (stopped_) return false;
-    const int i = index_of(module);
-    Track& tr = tracks_[static_cast<std::size_t>(i)];
-    const std::string where = "module '" + req_.modules[static_cast<std::size_t>(i)] + "', sample " + std::to_string(tr.count);
-    const double v[7] = {t, gyro[0], gyro[1], gyro[2], accel[0], accel[1], accel[2]};
-    for (int c = 0; c < 7; ++c)
-      if (!std::isfinite(v[c]))
-        throw InputError(where + " (0-based), column " + std::to_string(c) + " (" + kImuColumnNames[c] +
-                         "): value is " + (std::isnan(v[c]) ? "NaN" : "infinite"));
-    double dt;
-    if (tr.count == 0) {
-      dt = 1.0 / tr.options.rate_hz;
-    } else {
-      dt = t - tr.prev_t;
-      if (!(dt > 0.0))
-        throw InputError(where + " (0-based): time " + io_detail::format_double(t) +
-                         (dt == 0.0 ? " repeats the previous sample's time" : " goes back from the previous sample's " + io_detail::format_double(tr.prev_t)) +
-                         " (timestamps must be strictly increasing)");
-    }
     ImuRow row;
     row.t = t;
     row.gyro = Vec3(gyro[0], gyro[1], gyro[2]);
     row.accel = Vec3(accel[0], accel[1], accel[2]);
-    ImuSample s = imu_sample(row, dt, tr.options);
-    if (s.t < last_t_)
-      throw InputError(where + " (0-based): time " + io_detail::format_double(s.t) + " is before the last sample pushed (" +
-                       io_detail::format_double(last_t_) + "): push the modules' samples in time order");
-    tr.prev_t = t;
-    const std::uint64_t index = tr.count++;
-    last_t_ = s.t;
-    // The run's input checks (run/input_checks.hpp): a sample beyond the sensor range is
-    // left out (its interval goes to the next one), the rate, format and static period checked.
-    if (!tr.checks.admit(s, index)) return !stopped_;
-    if (in_warmup()) {
-      if (warmup_->add(i, s)) return true;
-      end_warmup();
-      if (stopped_) return false;
-    }
-    navigate(i, s);
-    return !stopped_;
-  }
-
-  /// The warm-up's estimates made, the navigator built with them and the kept samples navigated.
-  void end_warmup() {
-    calibration_ = warmup_->result();
-    make_navigator(apply_calibration(req_.manifest, calibration_));
-    for (const auto& k : warmup_->kept()) {
-      navigate(k.index, k.sample);
-      if (stopped_) break;
-    }
-    warmup_->release();
-    warmup_done_ = true;
-  }
-
-  void navigate(int i, const ImuSample& s) {
-    nav_->process(i, s);
-    if (non_finite_)
-      throw InputError("the navigation became non-finite (the vehicle solution) by t = " +
-                       io_detail::format_double(non_finite_t_) + " s: the filter diverged (an input or a setting "
-                       "outside what the checks catch)");
-    if (req_.max_duration > 0 && nav_->navigating() && s.t - nav_->stats().t_start >= req_.max_duration) stopped_ = true;
+    return run_->push(index_of(module), row);
   }
 
   void finish() {
-    if (finished_) return;
-    for (auto& tr : tracks_) tr.checks.finish();
-    if (in_warmup()) end_warmup();  // the data ended inside the warm-up: estimates from all of it
-    if (!nav_->navigating()) {
-      char period[96];
-      std::snprintf(period, sizeof period, "[%.3f, %.3f] s", req_.manifest.static_start, req_.manifest.static_end);
-      throw InputError("the samples end before the static period " + std::string(period) + " of '" +
-                       req_.manifest.path.string() + "' does: nothing to navigate");
-    }
-    nav_->finish();
-    finished_ = true;
+    if (!run_->finished()) run_->finish();
   }
 
   py::object state() const {
     if (!navigating()) return py::none();
-    const TrajectoryRecord r = nav_->vehicle_record();
+    const TrajectoryRecord r = nav().vehicle_record();
     const auto names = trajectory_csv_header();
     std::vector<double> v(names.size());
     trajectory_csv_values(r, v.data());
@@ -554,65 +453,51 @@ class StreamNavigator {
 
   py::array_t<double> covariance(const py::object& module) const {
     const int i = index_of(module);
-    if (in_warmup()) throw InputError("no covariance during the calibration warm-up (it ends at t = " +
-                                io_detail::format_double(warmup_->end()) + " s)");
-    if (!nav_->navigating()) throw InputError("no covariance before navigation starts (the static period)");
-    if (req_.nav.fusion.centralized)
+    if (run_->in_warmup()) throw InputError("no covariance during the calibration warm-up (it ends at t = " +
+                                            io_detail::format_double(run_->warmup_end()) + " s)");
+    if (!nav().navigating()) throw InputError("no covariance before navigation starts (the static period)");
+    if (run_->request().nav.fusion.centralized)
       throw InputError("the centralized filter keeps one joint covariance; its per-module blocks are not "
                        "exposed (the state's *_std_* entries are the vehicle's sigmas)");
-    const Mat21& P = nav_->subsystem(i).ekf().covariance();
+    const Mat21& P = nav().subsystem(i).ekf().covariance();
     py::array_t<double> a({21, 21});
     for (int r = 0; r < 21; ++r)
       for (int c = 0; c < 21; ++c) a.mutable_at(r, c) = P(r, c);
     return a;
   }
 
-  const std::vector<std::string>& modules() const { return req_.modules; }
-  bool navigating() const { return nav_->navigating(); }
+  const std::vector<std::string>& modules() const { return run_->request().modules; }
+  bool navigating() const { return nav().navigating(); }
   py::array_t<double> records() const { return table(records_); }
   std::size_t record_count() const { return records_.size(); }
-  py::dict stats() const { return stats_dict(nav_->stats()); }
-  std::string fault_report() const { return fault_report_text(nav_->faults()); }
+  py::dict stats() const { return stats_dict(nav().stats()); }
+  std::string fault_report() const { return fault_report_text(nav().faults()); }
   py::dict faults() const {
     std::vector<ModuleFaultStats> st;
-    for (int i = 0; i < nav_->faults().size(); ++i) st.push_back(nav_->faults().stats(i));
-    return faults_dict(nav_->faults().events(), req_.modules, st);
+    for (int i = 0; i < nav().faults().size(); ++i) st.push_back(nav().faults().stats(i));
+    return faults_dict(nav().faults().events(), modules(), st);
   }
   /// The noise model now, as noise.yaml's text.
   std::string noise_yaml() const {
     std::vector<ModuleNoiseReport> n;
-    for (int i = 0; i < nav_->subsystem_count(); ++i) n.push_back(nav_->noise_report(i));
-    return noise_report_yaml(n, req_.manifest, req_.nav.noise.enabled);
+    for (int i = 0; i < nav().subsystem_count(); ++i) n.push_back(nav().noise_report(i));
+    return noise_report_yaml(n, run_->request().manifest, run_->request().nav.noise.enabled);
   }
   /// The warm-up's estimates (calibration.yaml's text; None with the manifest's geometry or
   /// during the warm-up).
   py::object calibration() const {
-    if (!warmup_done_) return py::none();
-    return py::str(calibration_yaml(calibration_, req_.manifest));
+    if (!run_->calibrated()) return py::none();
+    return py::str(calibration_yaml(run_->calibration(), run_->request().manifest));
   }
   py::object calibration_report() const {
-    if (!warmup_done_) return py::none();
-    return py::str(wheelins::calibration_report(calibration_));
+    if (!run_->calibrated()) return py::none();
+    return py::str(wheelins::calibration_report(run_->calibration()));
   }
 
  private:
-  struct Track {
-    ImuReadOptions options;
-    double prev_t = 0.0;
-    std::uint64_t count = 0;
-    InputChecks checks;
-  };
-  RunRequest req_;
-  std::vector<Track> tracks_;
-  std::unique_ptr<Navigator> nav_;
-  std::unique_ptr<CalibrationWarmup> warmup_;  ///< calibration "estimate"
-  bool warmup_done_ = false;
-  bool in_warmup() const { return warmup_ && !warmup_done_; }
-  InstallationCalibration calibration_;
-  std::vector<TrajectoryRecord> records_;
-  double last_t_ = -std::numeric_limits<double>::infinity();
-  bool stopped_ = false, finished_ = false, non_finite_ = false;
-  double non_finite_t_ = 0.0;
+  const Navigator& nav() const { return run_->navigator(); }
+  std::vector<TrajectoryRecord> records_;  // before run_: its consumer writes here
+  std::unique_ptr<PushSession> run_;
 };
 
 }  // namespace

@@ -97,10 +97,10 @@ CalibrationWarmup::CalibrationWarmup(const Manifest& m, const std::vector<std::s
   if (std::isfinite(span)) kept_.reserve(static_cast<std::size_t>(std::min(per_s * span * 1.02, 1048576.0)) + 16);
 }
 
-bool CalibrationWarmup::add(int index, const ImuSample& s) {
+bool CalibrationWarmup::add(int index, const ImuSample& s, std::uint64_t record) {
   if (s.t > t_end_) return false;
   cals_.add(index, s);
-  kept_.push_back({index, s});
+  kept_.push_back({index, s, record});
   return true;
 }
 

@@ -4,6 +4,7 @@
 // table).
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <string>
@@ -60,12 +61,14 @@ class CalibrationWarmup {
                     const InstallationCalibrationOptions& opt, double warmup_s);
   /// The last time the estimators take [s].
   double end() const { return t_end_; }
-  /// Keeps sample `s` of module `index`; false (nothing kept) when it is past end().
-  bool add(int index, const ImuSample& s);
+  /// Keeps sample `s` of module `index` (`record`: its index in its source, for messages);
+  /// false (nothing kept) when it is past end().
+  bool add(int index, const ImuSample& s, std::uint64_t record = 0);
   InstallationCalibration result() const { return cals_.result(); }
   struct Kept {
     int index;
     ImuSample sample;
+    std::uint64_t record;
   };
   /// The kept samples in the order given.
   const std::vector<Kept>& kept() const { return kept_; }

@@ -1,0 +1,127 @@
+// A run fed with pushed records (push_session.hpp).
+#include "wheelins/run/push_session.hpp"
+
+#include <chrono>
+#include <algorithm>
+#include <cmath>
+
+#include "wheelins/io/text_util.hpp"
+
+namespace wheelins {
+using io_detail::format_double;
+
+namespace {
+RunRequest pushed(RunRequest r) {
+  r.data_checks = false;  // they read the files; the samples come from elsewhere
+  r.progress = false;     // the end is not known
+  return r;
+}
+}  // namespace
+
+PushSession::PushSession(RunRequest request, double calibration_warmup, std::string source)
+    : source_(std::move(source)) {
+  const bool estimate = request.calibration == CalibrationMode::kEstimate;
+  if (estimate && !(calibration_warmup > 0.0 && std::isfinite(calibration_warmup)))
+    throw InputError("calibration_warmup must be a positive number of seconds (given " +
+                     format_double(calibration_warmup) + ")");
+  // Built now in any case, so that every setting is checked here; with a warm-up the
+  // navigator is built again, on the estimates, when the warm-up ends.
+  session_ = std::make_unique<RunSession>(pushed(std::move(request)), &calibration_);
+  const RunRequest& r = session_->request();
+  if (estimate) {
+    // As a run with a duration: the estimates from no sample past it.
+    const double w = r.max_duration > 0.0 ? std::min(calibration_warmup, r.max_duration) : calibration_warmup;
+    warmup_ = std::make_unique<CalibrationWarmup>(r.manifest, r.modules, r.calibration_options, w);
+  }
+  tracks_.reserve(r.modules.size());  // (InputChecks keeps a reference to its spec)
+  for (const auto& name : r.modules) {
+    const ModuleSpec* spec = r.manifest.find(name);
+    tracks_.push_back(Track{imu_read_options(*spec), 0.0, 0,
+                            InputChecks(*spec, r.manifest, r.nav.faults.enabled, r.warn,
+                                        "module '" + name + "' (" + source_ + ")")});
+  }
+}
+
+PushSession::~PushSession() = default;
+
+double PushSession::warmup_end() const { return warmup_ ? warmup_->end() : 0.0; }
+
+// The record made into a sample as ImuFileReader makes it, and held to the input checks;
+// `admitted` false: left out (beyond the sensor range).
+ImuSample PushSession::checked_sample(int module, const ImuRow& row, bool& admitted) {
+  Track& tr = tracks_[static_cast<std::size_t>(module)];
+  const std::string where = "module '" + request().modules[static_cast<std::size_t>(module)] + "', sample " +
+                            std::to_string(tr.count) + " (0-based)";
+  const double v[7] = {row.t, row.gyro.x(), row.gyro.y(), row.gyro.z(), row.accel.x(), row.accel.y(), row.accel.z()};
+  for (int c = 0; c < 7; ++c)
+    if (!std::isfinite(v[c]))
+      throw InputError(where + ", column " + std::to_string(c) + " (" + kImuColumnNames[c] + "): value is " +
+                       (std::isnan(v[c]) ? "NaN" : "infinite"));
+  double dt = 1.0 / tr.options.rate_hz;
+  if (tr.count > 0) {
+    dt = row.t - tr.prev_t;
+    if (!(dt > 0.0))
+      throw InputError(where + ": time " + format_double(row.t) +
+                       (dt == 0.0 ? " repeats the previous sample's time"
+                                  : " goes back from the previous sample's " + format_double(tr.prev_t)) +
+                       " (timestamps must be strictly increasing)");
+  }
+  ImuSample s = imu_sample(row, dt, tr.options);
+  if (s.t < last_t_)
+    throw InputError(where + ": time " + format_double(s.t) + " is before the last sample pushed (" +
+                     format_double(last_t_) + "): push the modules' samples in time order");
+  tr.prev_t = row.t;
+  last_t_ = s.t;
+  admitted = tr.checks.admit(s, tr.count++);
+  return s;
+}
+
+bool PushSession::push(int module, const ImuRow& row) {
+  if (finished_) throw InputError("push after finish()");
+  if (module < 0 || module >= static_cast<int>(tracks_.size()))
+    throw InputError("module index " + std::to_string(module) + " out of range (0.." +
+                     std::to_string(tracks_.size() - 1) + ")");
+  if (stopped_) return false;
+  bool admitted = false;
+  const ImuSample s = checked_sample(module, row, admitted);
+  const std::uint64_t record = tracks_[static_cast<std::size_t>(module)].count - 1;
+  if (!admitted) return true;
+  if (in_warmup()) {
+    if (warmup_->add(module, s, record)) return true;
+    end_warmup();
+    if (stopped_) return false;
+  }
+  navigate(module, s, record);
+  return !stopped_;
+}
+
+void PushSession::navigate(int module, const ImuSample& s, std::uint64_t record) {
+  const auto t0 = std::chrono::steady_clock::now();
+  stopped_ = !session_->push(module, s, record);
+  process_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  session_->check_finite(s.t);
+}
+
+// The warm-up's estimates made, the navigator built with them and the kept samples navigated.
+void PushSession::end_warmup() {
+  calibration_ = warmup_->result();
+  session_->use_calibration(calibration_);
+  for (const auto& k : warmup_->kept()) {
+    navigate(k.index, k.sample, k.record);
+    if (stopped_) break;
+  }
+  warmup_->release();
+  warmup_done_ = true;
+}
+
+RunResult PushSession::finish() {
+  if (finished_) throw InputError("finish() called twice");
+  for (auto& tr : tracks_) tr.checks.finish();
+  if (in_warmup()) end_warmup();  // the data ended inside the warm-up: estimates from all of it
+  std::vector<SessionInput> inputs;
+  for (std::size_t i = 0; i < tracks_.size(); ++i) inputs.push_back(SessionInput{tracks_[i].checks.dropped(), source_ + " of " + request().modules[i]});
+  finished_ = true;
+  return session_->finish(process_seconds_, inputs);
+}
+
+}  // namespace wheelins
