@@ -58,20 +58,20 @@ ImuSample PushSession::checked_sample(int module, const ImuRow& row, bool& admit
   const double v[7] = {row.t, row.gyro.x(), row.gyro.y(), row.gyro.z(), row.accel.x(), row.accel.y(), row.accel.z()};
   for (int c = 0; c < 7; ++c)
     if (!std::isfinite(v[c]))
-      throw InputError(where() + ", column " + std::to_string(c) + " (" + kImuColumnNames[c] + "): value is " +
+      throw RejectedSample(where() + ", column " + std::to_string(c) + " (" + kImuColumnNames[c] + "): value is " +
                        (std::isnan(v[c]) ? "NaN" : "infinite"));
   double dt = 1.0 / tr.options.rate_hz;
   if (tr.count > 0) {
     dt = row.t - tr.prev_t;
     if (!(dt > 0.0))
-      throw InputError(where() + ": time " + format_double(row.t) +
+      throw RejectedSample(where() + ": time " + format_double(row.t) +
                        (dt == 0.0 ? " repeats the previous sample's time"
                                   : " goes back from the previous sample's " + format_double(tr.prev_t)) +
                        " (timestamps must be strictly increasing)");
   }
   ImuSample s = imu_sample(row, dt, tr.options);
   if (s.t < last_t_)
-    throw InputError(where() + ": time " + format_double(s.t) + " is before the last sample pushed (" +
+    throw RejectedSample(where() + ": time " + format_double(s.t) + " is before the last sample pushed (" +
                      format_double(last_t_) + "): push the modules' samples in time order");
   tr.prev_t = row.t;
   last_t_ = s.t;

@@ -16,6 +16,14 @@
 
 namespace wheelins {
 
+/// A pushed record the input checks refuse before it reaches the navigation (a value not
+/// finite, a time that repeats or goes back): the session is as before it, and a live source
+/// may go on with the next record. Other InputErrors from push() end the run.
+class RejectedSample : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 class PushSession {
  public:
   /// The request as run_navigation() takes it, less what needs the files: the manifest is not
@@ -31,7 +39,8 @@ class PushSession {
   /// One record of the request's module `module` (an index into its modules) as its source
   /// holds it (the manifest's format and axes; time before the module's time offset). Records
   /// must come in time order over all modules. False once the request's duration is reached
-  /// (push no more). InputError names the module, the sample and the value that is wrong.
+  /// (push no more). RejectedSample (an InputError) names the module, the sample and the value
+  /// that is wrong.
   bool push(int module, const ImuRow& row);
   /// The end of the data (a warm-up still open ends on what it has), the reports, the files.
   RunResult finish();
