@@ -1,0 +1,174 @@
+// `wheelins live`: navigate a stream of IMU records as they arrive (standard input) and
+// publish the vehicle's state (run/live_stream.hpp; docs/live.md).
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <optional>
+#include <sys/resource.h>
+
+#include "cli.hpp"
+#include "wheelins/io/text_util.hpp"
+#include "wheelins/run/live_stream.hpp"
+#include "wheelins/run/run_config.hpp"
+#include "wheelins/util/interrupt.hpp"
+
+namespace {
+using namespace wheelins;
+
+struct LiveArgs {
+  std::string config_file, manifest, configuration, chips, modules, out, formats, calibration, format = "json";
+  double warmup = 120.0, window = 0.05, publish_interval = 0.1;
+  std::optional<double> duration;
+  bool centralized = false, no_faults = false, fixed_noise = false, force = false, full_rate = false;
+};
+
+extern "C" void on_stop(int sig) {
+  // The first Ctrl-C / kill ends the stream as the end of input does (the files are written);
+  // a second one ends the process at once.
+  if (interrupt_requested()) {
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+  }
+  request_interrupt();
+}
+
+// Without SA_RESTART: a read waiting for input returns at the signal.
+void catch_stop_signals() {
+  struct sigaction sa = {};
+  sa.sa_handler = on_stop;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+}
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double cpu_seconds() {
+  rusage u = {};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+RunRequest live_request(const LiveArgs& a, const WarningSink& warn) {
+  RunOverrides o;
+  o.config = a.config_file;
+  o.manifest = a.manifest;
+  o.configuration = a.configuration;
+  if (!a.chips.empty()) o.chips = cli::split_list(a.chips);
+  if (!a.modules.empty()) o.modules = cli::split_list(a.modules);
+  o.output_dir = a.out;
+  if (!a.formats.empty()) o.formats = cli::split_list(a.formats);
+  o.calibration = a.calibration.empty() ? "estimate" : a.calibration;
+  if (a.centralized) o.centralized = true;
+  if (a.no_faults) o.fault_handling = false;
+  if (a.fixed_noise) o.fixed_noise = true;
+  o.duration = a.duration;
+  o.overwrite = a.force;
+  o.full_rate = a.full_rate;
+  RunRequest req = make_run_request(run_config_with(o, warn), warn);
+  if (a.out.empty()) req.output_dir.clear();  // the states go out; files only when asked for
+  return req;
+}
+
+void print_summary(const LiveStreamStats& st, const RunResult& res, double wall, double cpu) {
+  double median = 0.0, p99 = 0.0;
+  latency_percentiles(st.latency, median, p99);
+  const double worst = st.latency.empty() ? 0.0 : *std::max_element(st.latency.begin(), st.latency.end());
+  std::fprintf(stderr,
+               "wheelins live: %llu lines, %llu samples navigated over %.1f s, %llu states published; "
+               "left out: %llu unreadable or not navigated, %llu late, %llu refused by the input checks\n",
+               static_cast<unsigned long long>(st.lines), static_cast<unsigned long long>(st.samples),
+               res.stats.t_end - res.stats.t_start, static_cast<unsigned long long>(st.published),
+               static_cast<unsigned long long>(st.bad_lines), static_cast<unsigned long long>(st.late),
+               static_cast<unsigned long long>(st.rejected));
+  std::fprintf(stderr,
+               "latency from a line's arrival to the state published after it: median %.3f ms, 99th "
+               "percentile %.3f ms, max %.1f ms (%zu states); CPU %.2f s in %.2f s wall (%.1f %% of one "
+               "core)\n",
+               1e3 * median, 1e3 * p99, 1e3 * worst, st.latency.size(), cpu, wall, wall > 0 ? 100.0 * cpu / wall : 0.0);
+  if (!res.files.empty())
+    std::fprintf(stderr, "wrote %zu files to %s\n", res.files.size(),
+                 res.files.front().parent_path().string().c_str());
+}
+
+int live(const LiveArgs& a) {
+  if (a.format != "json" && a.format != "csv")
+    throw InputError("--format '" + a.format + "': json (JSON lines) or csv");
+  if (!(a.warmup > 0.0 && a.warmup <= 3600.0))
+    throw InputError("--calibration-warmup " + io_detail::format_double(a.warmup) + ": must be in (0, 3600] s");
+  const WarningSink warn = [](const std::string& w) { std::fprintf(stderr, "warning: %s\n", w.c_str()); };
+  PushSession session(live_request(a, warn), a.warmup, "standard input");
+  LiveStreamOptions opt;
+  opt.window = a.window;
+  opt.publish_interval = a.publish_interval;
+  opt.csv = a.format == "csv";
+  LiveStream stream(session, opt, stdout, stderr);
+  std::string mods;
+  for (const auto& m : session.request().modules) mods += (mods.empty() ? "" : ", ") + m;
+  std::fprintf(stderr, "wheelins live: %s on '%s'; reading `module, t, gx, gy, gz, ax, ay, az` lines from "
+                       "standard input (end of input or Ctrl-C ends the run)\n",
+               mods.c_str(), session.request().manifest.path.string().c_str());
+
+  catch_stop_signals();
+  const double wall0 = now_seconds(), cpu0 = cpu_seconds();
+  char* buf = nullptr;
+  std::size_t cap = 0;
+  for (;;) {
+    errno = 0;
+    const ssize_t n = ::getline(&buf, &cap, stdin);
+    if (n < 0 || interrupt_requested()) break;  // the end of input, a signal
+    if (!stream.line(std::string_view(buf, static_cast<std::size_t>(n)), now_seconds())) break;
+  }
+  std::free(buf);
+  const bool stopped = interrupt_requested();
+  clear_interrupt();
+  if (stopped) std::fprintf(stderr, "wheelins live: stopped by a signal: the run ends here\n");
+  stream.end();
+  const RunResult res = session.finish();
+  print_summary(stream.stats(), res, now_seconds() - wall0, cpu_seconds() - cpu0);
+  if (stream.stats().left_out() > 0) {
+    std::fprintf(stderr, "wheelins live: %llu input lines were left out (reported above): exit 3\n",
+                 static_cast<unsigned long long>(stream.stats().left_out()));
+    return 3;
+  }
+  return 0;
+}
+
+const bool registered = cli::register_command(
+    25, "live", "Navigate IMU records as they arrive on standard input and publish the state",
+    [](CLI::App& sub) {
+      auto a = std::make_shared<LiveArgs>();
+      sub.add_option("config", a->config_file, "Run configuration (YAML; see docs/run-config.md)");
+      sub.add_option("--manifest,-m", a->manifest, "Dataset manifest: the modules, their geometry and formats");
+      sub.add_option("--configuration,-c", a->configuration, "IMU configuration, as `wheelins run` (default: single)");
+      sub.add_option("--chips", a->chips, "Chip per IMU, e.g. C1,C4");
+      sub.add_option("--modules", a->modules, "Explicit module names (instead of a configuration)");
+      sub.add_option("--out,-o", a->out, "Also write the run's files here at the end (as `wheelins run`)");
+      sub.add_option("--formats", a->formats, "Trajectory formats of those files: csv,tum,kml");
+      sub.add_option("--format", a->format, "The published states: json (JSON lines; default) or csv");
+      sub.add_option("--publish-interval", a->publish_interval,
+                     "Seconds of data between published states (default 0.1; 0: after every sample)");
+      sub.add_option("--window", a->window,
+                     "Reorder window [s]: records up to this much older than the newest are put back in "
+                     "order; older ones are dropped (default 0.05)");
+      sub.add_option("--calibration", a->calibration,
+                     "estimate (default: the installation from the first seconds after the static period) "
+                     "| manifest (as given)");
+      sub.add_option("--calibration-warmup", a->warmup,
+                     "Seconds of data the installation is estimated from (default 120); no state is "
+                     "published before its end");
+      sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
+      sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
+      sub.add_flag("--no-fault-handling", a->no_faults, "Use every sample and module as it comes");
+      sub.add_flag("--fixed-noise", a->fixed_noise, "Hold the noise figures fixed");
+      sub.add_flag("--full-rate", a->full_rate, "The trajectory files at every record");
+      sub.add_flag("--force,-f", a->force, "Overwrite existing results in --out");
+      return [a]() { return live(*a); };
+    });
+}  // namespace
