@@ -14,12 +14,12 @@ RunEvaluation::RunEvaluation(const std::filesystem::path& truth_file, const eart
       truth_time_offset_(options.eval.truth_time_offset) {
   Evaluator::Sources src;
   src.truth_file = truth_->file().string();
-  src.traj_file = "the run's vehicle solution";
+  src.traj_file = options.solution;
   src.traj_format = "memory";
   src.truth_layout = truth_layout_name(truth_->layout());
   src.truth_has_attitude = truth_->has_attitude();
   src.truth_has_velocity = truth_->has_velocity();
-  evaluator_ = std::make_unique<StartAlignedEvaluator>(earth::LocalFrame(origin), src, options.eval, false);
+  evaluator_ = std::make_unique<StartAlignedEvaluator>(earth::LocalFrame(origin), src, options.eval, options.keep_series);
   have_next_truth_ = truth_->next(next_truth_);
 }
 

@@ -26,6 +26,8 @@ struct RunEvaluationOptions {
   TruthLayout layout = TruthLayout::kAuto;
   TruthReadOptions truth{};  ///< time scale and offset on read, text columns, TUM frame and origin
   EvalOptions eval{};      ///< antenna lever arm, truth time offset, segment length, ...
+  bool keep_series = false;  ///< the per-epoch errors in EvalResult::series (studies' plots)
+  std::string solution = "the run's vehicle solution";  ///< names the trajectory in messages
 };
 
 class RunEvaluation {

@@ -19,6 +19,7 @@
 #include <sstream>
 #include <thread>
 
+#include "wheelins/eval/run_evaluation.hpp"
 #include "wheelins/io/atomic_file.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/io/yaml_reader.hpp"
@@ -200,28 +201,16 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     if (!req.manifest.truth_file)
       throw InputError("'" + req.manifest.path.string() +
                        "': no truth file (key `truth`): a study evaluates every run against it");
-    TruthReader truth(req.manifest.resolve(*req.manifest.truth_file));
-    eval::Evaluator::Sources src;
-    src.truth_file = truth.file().string();
-    src.traj_file = "the vehicle solution of " + who;
-    src.traj_format = "memory";
-    src.truth_layout = truth_layout_name(truth.layout());
-    src.truth_has_attitude = truth.has_attitude();
-    src.truth_has_velocity = truth.has_velocity();
-    eval::Evaluator ev(earth::LocalFrame(req.manifest.origin), src, eval::EvalOptions{},
-                       j.keep_series);
-    TruthRecord next;
-    bool have = truth.next(next);
+    // The evaluation `wheelins run` makes (eval/run_evaluation.hpp): the truth streamed in step
+    // with the run, so memory stays flat however long the data.
+    eval::RunEvaluationOptions eo;
+    eo.keep_series = j.keep_series;
+    eo.solution = "the vehicle solution of " + who;
+    eval::RunEvaluation ev(req.manifest.resolve(*req.manifest.truth_file), req.manifest.origin, eo);
     std::vector<TrajectoryRecord> track;
     std::size_t records = 0;
-    // In step with the run: the truth records before each vehicle record go in first (as
-    // eval::evaluate() does), so memory stays flat however long the data.
     req.on_record = [&](const TrajectoryRecord& r) {
-      while (have && next.t < r.t) {
-        ev.add_truth(next);
-        have = truth.next(next);
-      }
-      ev.add_trajectory(r);
+      ev.add(r);
       if (j.keep_series && records % 20 == 0) track.push_back(r);  // 1 Hz of the 20 Hz records
       ++records;
     };
@@ -231,11 +220,6 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     tm.navigate = since(t);
     tm.filter = rr.filter_seconds;
     t = std::chrono::steady_clock::now();
-    ev.end_trajectory();
-    while (have) {
-      ev.add_truth(next);
-      have = truth.next(next);
-    }
     eval::EvalResult e = ev.finish();
     if (j.keep_series) {
       std::vector<eval::EpochError> kept;  // 10 Hz of the 200 Hz truth epochs
