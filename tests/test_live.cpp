@@ -182,9 +182,15 @@ TEST_F(LiveCliTest, ADatasetPipedThroughStandardInputGivesTheFileRunsTrajectory)
   std::istringstream states(iotest::read_text_file(out.string() + ".states"));
   std::string l;
   int n = 0;
+  double prev_t = 0.0;
   while (std::getline(states, l)) {
     ++n;
     ASSERT_EQ(l.rfind("{\"t_s\":", 0), 0u) << l;
+    const double t = std::stod(l.substr(7));
+    if (n > 1) {
+      EXPECT_NEAR(t - prev_t, 0.1, 1e-6) << "state " << n;  // every 0.1 s of data
+    }
+    prev_t = t;
     ASSERT_EQ(l.back(), '}');
     EXPECT_EQ(l.find("null"), std::string::npos) << l;
     EXPECT_NE(l.find("\"north_std_m\":"), std::string::npos);

@@ -123,7 +123,7 @@ LiveStream::LiveStream(PushSession& session, const LiveStreamOptions& options, s
   header_ = trajectory_csv_header();
   values_.assign(header_.size(), 0.0);
   text_.reserve(64 * header_.size());
-  stats_.latency.reserve(1u << 20);
+  stats_.latency.reserve(1u << 16);  // 6.5 h of states at 10 Hz before it grows
   if (options_.csv) {
     std::string h;
     for (std::size_t k = 0; k < header_.size(); ++k) h += (k ? "," : "") + header_[k];
@@ -220,11 +220,16 @@ bool LiveStream::navigate(const ReorderWindow::Item& item) {
     said_waiting_ = true;
     return more;
   }
-  if (item.key >= next_publish_) {
+  // On a grid of publish_interval from the first state (first + n * interval, not a sum that
+  // drifts; 1 us of slack for the stamps' rounding); after a gap, the grid starts again.
+  if (!published_any_ || item.key + 1e-6 >= next_publish_) {
     publish();
-    next_publish_ = options_.publish_interval > 0.0
-                        ? std::max(next_publish_ + options_.publish_interval, item.key)
-                        : item.key;
+    if (!published_any_ || item.key >= next_publish_ + options_.publish_interval) {
+      grid_start_ = item.key;
+      grid_steps_ = 0;
+    }
+    next_publish_ = grid_start_ + static_cast<double>(++grid_steps_) * options_.publish_interval;
+    published_any_ = true;
   }
   return more;
 }

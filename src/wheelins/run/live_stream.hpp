@@ -117,7 +117,9 @@ class LiveStream {
   std::vector<std::string> header_;
   std::string text_;              ///< one state's line
   int reported_[kKinds] = {0, 0, 0};
-  double next_publish_ = -1e300;
+  double next_publish_ = 0.0, grid_start_ = 0.0;
+  std::uint64_t grid_steps_ = 0;
+  bool published_any_ = false;
   bool said_waiting_ = false, said_warmup_ = false, stopped_ = false;
   LiveStreamStats stats_;
 };
