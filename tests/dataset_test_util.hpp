@@ -16,8 +16,20 @@
 
 #include "io_test_util.hpp"
 #include "wheelins/nav/types.hpp"
+#include "wheelins/sim/simulator.hpp"
 
 namespace wheelins::dstest {
+
+/// A short simulated dataset in `dir` (the datasheet profile, one chip per module, no ideal
+/// streams): `duration` seconds of the default scenario, the first 30 of them standing.
+inline void simulate_short(const std::filesystem::path& dir, double duration) {
+  sim::SimConfig cfg;
+  cfg.set_profile("datasheet");
+  cfg.chips = 1;
+  cfg.duration = duration;
+  cfg.write_ideal = false;
+  sim::Simulation(cfg).write(dir, false, false);
+}
 
 /// A file of float64 values (an IMU file, GINS.bin) as read.
 inline std::vector<double> read_doubles(const std::filesystem::path& file) {

@@ -14,11 +14,11 @@
 #include <tuple>
 #include <vector>
 
+#include "dataset_test_util.hpp"
 #include "io_test_util.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/run/live_stream.hpp"
 #include "wheelins/run/presets.hpp"
-#include "wheelins/sim/simulator.hpp"
 
 using namespace wheelins;
 namespace fs = std::filesystem;
@@ -106,12 +106,7 @@ class LiveCliTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new iotest::ScratchDir();
-    sim::SimConfig cfg;
-    cfg.set_profile("datasheet");
-    cfg.chips = 1;
-    cfg.duration = 60.0;  // 30 s of it standing (the static period)
-    cfg.write_ideal = false;
-    sim::Simulation(cfg).write(dir_->path() / "data", false, false);
+    dstest::simulate_short(dir_->path() / "data", 60.0);  // 30 s of it standing
   }
   static void TearDownTestSuite() {
     delete dir_;
@@ -126,9 +121,7 @@ class LiveCliTest : public ::testing::Test {
     std::vector<std::tuple<double, std::size_t, std::size_t>> order;
     std::vector<std::vector<double>> data;
     for (std::size_t i = 0; i < modules.size(); ++i) {
-      const std::string bytes = iotest::read_text_file(m.resolve(m.find(modules[i])->file));
-      data.emplace_back(bytes.size() / sizeof(double));
-      std::memcpy(data.back().data(), bytes.data(), data.back().size() * sizeof(double));
+      data.push_back(dstest::read_doubles(m.resolve(m.find(modules[i])->file)));
       for (std::size_t k = 0; k + 7 <= data.back().size(); k += 7) order.emplace_back(data.back()[k], i, k);
     }
     std::sort(order.begin(), order.end());

@@ -12,13 +12,13 @@
 #include <tuple>
 #include <vector>
 
+#include "dataset_test_util.hpp"
 #include "io_test_util.hpp"
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/push_session.hpp"
 #include "wheelins/run/run.hpp"
-#include "wheelins/sim/simulator.hpp"
 
 using namespace wheelins;
 namespace fs = std::filesystem;
@@ -29,12 +29,7 @@ class RunSessionTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new iotest::ScratchDir();
-    sim::SimConfig cfg;
-    cfg.set_profile("datasheet");
-    cfg.chips = 1;
-    cfg.duration = 70.0;  // 30 s of it standing (the static period)
-    cfg.write_ideal = false;
-    sim::Simulation(cfg).write(dir_->path() / "data", false, false);
+    dstest::simulate_short(dir_->path() / "data", 70.0);  // 30 s of it standing
   }
   static void TearDownTestSuite() {
     delete dir_;
@@ -57,9 +52,7 @@ class RunSessionTest : public ::testing::Test {
     std::vector<std::tuple<double, int, std::size_t>> order;
     std::vector<std::vector<double>> data;
     for (std::size_t i = 0; i < r.modules.size(); ++i) {
-      const std::string bytes = iotest::read_text_file(r.manifest.resolve(r.manifest.find(r.modules[i])->file));
-      data.emplace_back(bytes.size() / sizeof(double));
-      std::memcpy(data.back().data(), bytes.data(), data.back().size() * sizeof(double));
+      data.push_back(dstest::read_doubles(r.manifest.resolve(r.manifest.find(r.modules[i])->file)));
       for (std::size_t k = 0; k + 7 <= data.back().size(); k += 7) order.emplace_back(data.back()[k], int(i), k);
     }
     std::sort(order.begin(), order.end());
