@@ -1,14 +1,20 @@
 // `wheelins live`: navigate a stream of IMU records as they arrive (standard input) and
 // publish the vehicle's state (run/live_stream.hpp; docs/live.md).
+#include <poll.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <optional>
-#include <sys/resource.h>
+#include <string>
+#include <string_view>
 
 #include "cli.hpp"
 #include "wheelins/io/text_util.hpp"
@@ -26,6 +32,58 @@ struct LiveArgs {
   bool centralized = false, no_faults = false, fixed_noise = false, force = false, full_rate = false;
 };
 
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// Lines of a file descriptor as they arrive, read with read(2) and a poll of 0.1 s, so that a
+/// signal is seen within that time whichever thread the kernel hands it to (the run's writer
+/// runs on a thread of its own) and stdio's buffering does not hold lines back.
+class LineReader {
+ public:
+  enum Got { kLine, kNothing, kEnd };
+  explicit LineReader(int fd) : fd_(fd) { buf_.reserve(1 << 16); }
+  /// kLine: `line` (valid until the next call) and `arrival`, the steady-clock time of the read
+  /// that completed it; kNothing: no whole line within 0.1 s; kEnd: the end of input.
+  Got next(std::string_view& line, double& arrival) {
+    for (;;) {
+      const std::size_t nl = buf_.find('\n', start_);
+      if (nl != std::string::npos || (eof_ && start_ < buf_.size())) {
+        const std::size_t end = nl == std::string::npos ? buf_.size() : nl;
+        line = std::string_view(buf_).substr(start_, end - start_);
+        start_ = nl == std::string::npos ? buf_.size() : nl + 1;
+        arrival = read_time_;
+        return kLine;
+      }
+      if (eof_) return kEnd;
+      buf_.erase(0, start_);
+      start_ = 0;
+      pollfd p{fd_, POLLIN, 0};
+      const int ready = ::poll(&p, 1, 100);
+      if (ready <= 0) {
+        if (ready < 0 && errno != EINTR) throw InputError(std::string("standard input: ") + std::strerror(errno));
+        return kNothing;
+      }
+      char chunk[1 << 14];
+      const ssize_t n = ::read(fd_, chunk, sizeof chunk);
+      if (n < 0) {
+        if (errno == EINTR || errno == EAGAIN) return kNothing;
+        throw InputError(std::string("standard input: ") + std::strerror(errno));
+      }
+      read_time_ = now_seconds();
+      if (n == 0) eof_ = true;
+      buf_.append(chunk, static_cast<std::size_t>(n));
+    }
+  }
+
+ private:
+  int fd_;
+  std::string buf_;
+  std::size_t start_ = 0;
+  double read_time_ = 0.0;
+  bool eof_ = false;
+};
+
 extern "C" void on_stop(int sig) {
   // The first Ctrl-C / kill ends the stream as the end of input does (the files are written);
   // a second one ends the process at once.
@@ -36,16 +94,12 @@ extern "C" void on_stop(int sig) {
   request_interrupt();
 }
 
-// Without SA_RESTART: a read waiting for input returns at the signal.
+// The flag is seen by the reading loop within its poll's 0.1 s.
 void catch_stop_signals() {
   struct sigaction sa = {};
   sa.sa_handler = on_stop;
   sigemptyset(&sa.sa_mask);
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
-}
-
-double now_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 double cpu_seconds() {
@@ -117,15 +171,14 @@ int live(const LiveArgs& a) {
 
   catch_stop_signals();
   const double wall0 = now_seconds(), cpu0 = cpu_seconds();
-  char* buf = nullptr;
-  std::size_t cap = 0;
-  for (;;) {
-    errno = 0;
-    const ssize_t n = ::getline(&buf, &cap, stdin);
-    if (n < 0 || interrupt_requested()) break;  // the end of input, a signal
-    if (!stream.line(std::string_view(buf, static_cast<std::size_t>(n)), now_seconds())) break;
+  LineReader in(STDIN_FILENO);
+  std::string_view text;
+  double arrival = 0.0;
+  for (bool more = true; more && !interrupt_requested();) {
+    const LineReader::Got got = in.next(text, arrival);
+    if (got == LineReader::kEnd) break;
+    if (got == LineReader::kLine) more = stream.line(text, arrival);
   }
-  std::free(buf);
   const bool stopped = interrupt_requested();
   clear_interrupt();
   if (stopped) std::fprintf(stderr, "wheelins live: stopped by a signal: the run ends here\n");

@@ -249,4 +249,31 @@ TEST_F(LiveCliTest, PublishesCsvRowsAtTheAskedIntervalAndRefusesBadOptions) {
   EXPECT_NE(none.err.find("the data end before the static period"), std::string::npos) << none.err;
 }
 
+TEST_F(LiveCliTest, ASignalEndsTheRunAsTheEndOfInputDoesAndTheFilesAreWritten) {
+  // The input stays open (a logger still running) until the program is told to stop.
+  const std::vector<std::string> text = lines("triple");
+  const fs::path out = dir_->path() / "signal", in = dir_->path() / "signal.lines";
+  {
+    std::ofstream f(in);
+    for (std::size_t k = 0; k < text.size() * 3 / 4; ++k) f << text[k] << '\n';
+  }
+  const std::string states = out.string() + ".states";
+  // Through a named pipe, so that the shell waits for the program alone (not the feeder).
+  const std::string fifo = out.string() + ".fifo";
+  const std::string script =
+      "mkfifo '" + fifo + "' || exit 9; (cat '" + in.string() + "'; sleep 20) >'" + fifo + "' 2>/dev/null & feeder=$!; '" +
+      WHEELINS_BINARY + "' live -m '" + manifest().string() + "' -c triple --calibration manifest -o '" +
+      out.string() + "' <'" + fifo + "' >'" + states + "' 2>'" + out.string() + ".err' & pid=$!; n=0; while [ ! -s '" +
+      states + "' ] && [ $n -lt 600 ]; do sleep 0.1; n=$((n+1)); done; sleep 0.5; kill -INT $pid; wait $pid; "
+      "rc=$?; kill $feeder 2>/dev/null; exit $rc";
+  const int status = std::system(script.c_str());
+  const std::string err = iotest::read_text_file(out.string() + ".err");
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << err;
+  EXPECT_NE(err.find("stopped by a signal: the run ends here"), std::string::npos) << err;
+  EXPECT_NE(err.find("left out: 0 unreadable"), std::string::npos) << err;
+  EXPECT_TRUE(fs::exists(out / "trajectory.csv")) << err;
+  EXPECT_GT(iotest::read_text_file(out / "trajectory.csv").size(), 1000u);
+}
+
 }  // namespace
