@@ -158,14 +158,137 @@ const char* job_state_name(JobState s) {
   }
 }
 
+namespace {
+
+/// The navigator's statistics and the fault count, as a job's result holds them.
+void write_run_stats(JsonWriter& w, const RunResult& rr) {
+  const NavigatorStats& st = rr.stats;
+  auto count = [](std::uint64_t n) { return static_cast<std::int64_t>(n); };
+  w.begin_object("stats")
+      .integer("samples", count(st.samples))
+      .integer("epochs", count(st.epochs))
+      .integer("records", count(st.records))
+      .num("t_start_s", st.t_start)
+      .num("t_end_s", st.t_end)
+      .integer("velocity_updates", count(st.velocity_updates))
+      .integer("velocity_rejected", count(st.velocity_rejected))
+      .num("max_velocity_test_ratio", st.max_velocity_test_ratio)
+      .integer("position_updates", count(st.position_updates))
+      .integer("position_rejected", count(st.position_rejected))
+      .num("max_position_test_ratio", st.max_position_test_ratio)
+      .integer("velocity_steps", count(st.velocity_steps))
+      .integer("position_steps", count(st.position_steps))
+      .integer("covariance_checks", count(st.covariance_checks))
+      .integer("covariance_not_pd", count(st.covariance_not_pd))
+      .num("max_covariance_asymmetry", st.max_covariance_asymmetry)
+      .integer("fault_events", count(rr.fault_events.size()))
+      .end_object();
+}
+
+void write_timing(JsonWriter& w, const JobTiming& tm, double total, const NavigatorStats& st) {
+  w.begin_object("timing")
+      .num("total_s", total)
+      .num("dataset_s", tm.dataset)
+      .boolean("dataset_generated", tm.generated)
+      .num("setup_s", tm.setup)
+      .num("navigate_s", tm.navigate)
+      .num("finish_s", tm.finish)
+      .num("filter_s", tm.filter)
+      .num("velocity_step_s", st.velocity_step_seconds)
+      .num("position_step_s", st.position_step_seconds)
+      .num("started_unix", tm.started)
+      .num("finished_unix", tm.finished)
+      .str("host", tm.host)
+      .end_object();
+}
+
+/// A job's result (kJobResultFormat); the time since `t_finish` is the job's finish time and
+/// since `t0` its total.
+std::string result_json(const Study& s, const Job& j, const PreparedDataset& data,
+                        const std::vector<std::string>& modules, const eval::EvalResult& e, const RunResult& rr,
+                        const std::vector<std::string>& warnings, JobTiming& tm,
+                        std::chrono::steady_clock::time_point t_finish, std::chrono::steady_clock::time_point t0) {
+  JsonWriter w;
+  w.begin_object();
+  w.str("format", kJobResultFormat);
+  w.integer("job", static_cast<std::int64_t>(j.index));
+  w.str("key", j.key);
+  w.str("study", s.name());
+  write_labels(w, s, j);
+  w.str("configuration", j.configuration);
+  w.begin_object("dataset").str("data", j.dataset.describe()).str("manifest", data.manifest.string());
+  if (!j.dataset.cache_name.empty()) w.str("cache", j.dataset.cache_name);
+  w.end_object();
+  w.strings("modules", modules);
+  w.raw("evaluation", eval::to_json(e));
+  write_run_stats(w, rr);
+  w.str("fault_report", rr.fault_report);
+  w.strings("warnings", warnings);
+  w.str("run_config", "dataset: " + data.manifest.string() + "\n" + j.run_yaml);
+  w.str("canonical", j.canonical);
+  tm.finish = since(t_finish);
+  tm.finished = unix_now();
+  write_timing(w, tm, since(t0), rr.stats);
+  w.str("status", "done");
+  w.end_object();
+  return w.text();
+}
+
+/// A failed job's record (wheelins-study-failure-1).
+std::string failure_json(const Study& s, const Job& j, const std::string& error,
+                         const std::vector<std::string>& warnings, const JobTiming& tm) {
+  JsonWriter w;
+  w.begin_object();
+  w.str("format", "wheelins-study-failure-1");
+  w.integer("job", static_cast<std::int64_t>(j.index));
+  w.str("key", j.key);
+  w.str("study", s.name());
+  write_labels(w, s, j);
+  w.str("error", error);
+  w.strings("warnings", warnings);
+  w.str("canonical", j.canonical);
+  w.num("started_unix", tm.started);
+  w.num("failed_unix", unix_now());
+  w.str("host", tm.host);
+  w.str("status", "failed");
+  w.end_object();
+  return w.text();
+}
+
+/// A job's run request: its run settings over the dataset's manifest, nothing written, the
+/// warnings collected (and, after manifest edits, a warning of the manifest an error).
+RunRequest job_request(const Study& s, const Job& j, const JobOptions& o, const PreparedDataset& data,
+                       const std::string& who, std::vector<std::string>& warnings) {
+  const std::string where = "'" + s.file().string() + "': run settings of " + who;
+  const RunConfig cfg = load_run_yaml(j.run_yaml, data.manifest, where);
+  const WarningSink collect = [&warnings, who, warn = o.warn](const std::string& m) {
+    warnings.push_back(m);
+    if (warn) warn(who + ": " + m);
+  };
+  // An edited manifest must read without warnings: a misspelt key would be ignored.
+  const WarningSink manifest_warn =
+      j.dataset.manifest_edits.empty() ? collect : WarningSink([](const std::string& m) {
+        throw InputError(m + " (after the study's manifest edits)");
+      });
+  RunRequest req = make_run_request(cfg, manifest_warn);
+  req.output_dir.clear();
+  req.progress = o.progress;
+  req.warn = collect;
+  if (!req.manifest.truth_file)
+    throw InputError("'" + req.manifest.path.string() +
+                     "': no truth file (key `truth`): a study evaluates every run against it");
+  return req;
+}
+
+}  // namespace
+
 JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
   JobOutcome out;
   JobTiming& tm = out.timing;
   tm.started = unix_now();
   tm.host = host_name();
   const auto t0 = std::chrono::steady_clock::now();
-  const std::string K = std::to_string(j.index);
-  const std::string who = "job " + K;
+  const std::string who = "job " + std::to_string(j.index);
   std::error_code ec;
   fs::create_directories(s.jobs_dir(), ec);
   if (ec) throw InputError("'" + s.jobs_dir().string() + "': cannot create: " + ec.message());
@@ -174,33 +297,13 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
   fs::remove(result_file(s, j.index), ec);
 
   std::vector<std::string> warnings;
-  std::string result;
-  std::vector<std::pair<fs::path, std::string>> side;
   try {
     auto t = std::chrono::steady_clock::now();
     const PreparedDataset data = prepare_dataset(j.dataset, s.cache_dir());
     tm.dataset = since(t);
     tm.generated = data.generated;
     t = std::chrono::steady_clock::now();
-
-    const std::string where = "'" + s.file().string() + "': run settings of " + who;
-    const RunConfig cfg = load_run_yaml(j.run_yaml, data.manifest, where);
-    const WarningSink collect = [&](const std::string& m) {
-      warnings.push_back(m);
-      if (o.warn) o.warn(who + ": " + m);
-    };
-    // An edited manifest must read without warnings: a misspelt key would be ignored.
-    const WarningSink manifest_warn =
-        j.dataset.manifest_edits.empty() ? collect : WarningSink([&](const std::string& m) {
-          throw InputError(m + " (after the study's manifest edits)");
-        });
-    RunRequest req = make_run_request(cfg, manifest_warn);
-    req.output_dir.clear();
-    req.progress = o.progress;
-    req.warn = collect;
-    if (!req.manifest.truth_file)
-      throw InputError("'" + req.manifest.path.string() +
-                       "': no truth file (key `truth`): a study evaluates every run against it");
+    RunRequest req = job_request(s, j, o, data, who, warnings);
     // The evaluation `wheelins run` makes (eval/run_evaluation.hpp): the truth streamed in step
     // with the run, so memory stays flat however long the data.
     eval::RunEvaluationOptions eo;
@@ -221,6 +324,7 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     tm.filter = rr.filter_seconds;
     t = std::chrono::steady_clock::now();
     eval::EvalResult e = ev.finish();
+    std::vector<std::pair<fs::path, std::string>> side;
     if (j.keep_series) {
       std::vector<eval::EpochError> kept;  // 10 Hz of the 200 Hz truth epochs
       for (std::size_t k = 0; k < e.series.size(); k += 20) kept.push_back(e.series[k]);
@@ -231,64 +335,7 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     out.summary = "drift " + fmt(100.0 * e.drift_rate, 3) + " %, heading " +
                   fmt(e.heading_rmse / kDeg, 2) + " deg";
 
-    const NavigatorStats& st = rr.stats;
-    JsonWriter w;
-    w.begin_object();
-    w.str("format", kJobResultFormat);
-    w.integer("job", static_cast<std::int64_t>(j.index));
-    w.str("key", j.key);
-    w.str("study", s.name());
-    write_labels(w, s, j);
-    w.str("configuration", j.configuration);
-    w.begin_object("dataset")
-        .str("data", j.dataset.describe())
-        .str("manifest", data.manifest.string());
-    if (!j.dataset.cache_name.empty()) w.str("cache", j.dataset.cache_name);
-    w.end_object();
-    w.strings("modules", req.modules);
-    w.raw("evaluation", eval::to_json(e));
-    w.begin_object("stats")
-        .integer("samples", static_cast<std::int64_t>(st.samples))
-        .integer("epochs", static_cast<std::int64_t>(st.epochs))
-        .integer("records", static_cast<std::int64_t>(st.records))
-        .num("t_start_s", st.t_start)
-        .num("t_end_s", st.t_end)
-        .integer("velocity_updates", static_cast<std::int64_t>(st.velocity_updates))
-        .integer("velocity_rejected", static_cast<std::int64_t>(st.velocity_rejected))
-        .num("max_velocity_test_ratio", st.max_velocity_test_ratio)
-        .integer("position_updates", static_cast<std::int64_t>(st.position_updates))
-        .integer("position_rejected", static_cast<std::int64_t>(st.position_rejected))
-        .num("max_position_test_ratio", st.max_position_test_ratio)
-        .integer("velocity_steps", static_cast<std::int64_t>(st.velocity_steps))
-        .integer("position_steps", static_cast<std::int64_t>(st.position_steps))
-        .integer("covariance_checks", static_cast<std::int64_t>(st.covariance_checks))
-        .integer("covariance_not_pd", static_cast<std::int64_t>(st.covariance_not_pd))
-        .num("max_covariance_asymmetry", st.max_covariance_asymmetry)
-        .integer("fault_events", static_cast<std::int64_t>(rr.fault_events.size()))
-        .end_object();
-    w.str("fault_report", rr.fault_report);
-    w.strings("warnings", warnings);
-    w.str("run_config", "dataset: " + data.manifest.string() + "\n" + j.run_yaml);
-    w.str("canonical", j.canonical);
-    tm.finish = since(t);
-    tm.finished = unix_now();
-    w.begin_object("timing")
-        .num("total_s", since(t0))
-        .num("dataset_s", tm.dataset)
-        .boolean("dataset_generated", tm.generated)
-        .num("setup_s", tm.setup)
-        .num("navigate_s", tm.navigate)
-        .num("finish_s", tm.finish)
-        .num("filter_s", tm.filter)
-        .num("velocity_step_s", st.velocity_step_seconds)
-        .num("position_step_s", st.position_step_seconds)
-        .num("started_unix", tm.started)
-        .num("finished_unix", tm.finished)
-        .str("host", tm.host)
-        .end_object();
-    w.str("status", "done");
-    w.end_object();
-    result = w.text();
+    const std::string result = result_json(s, j, data, req.modules, e, rr, warnings, tm, t, t0);
 
     t = std::chrono::steady_clock::now();
     for (const auto& [file, text] : side) write_file_atomic(file, text);
@@ -300,22 +347,7 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     out.error = e.what();
     // A result of these settings from before (a rerun) is not this run's: leave none behind.
     fs::remove(result_file(s, j.index), ec);
-    JsonWriter w;
-    w.begin_object();
-    w.str("format", "wheelins-study-failure-1");
-    w.integer("job", static_cast<std::int64_t>(j.index));
-    w.str("key", j.key);
-    w.str("study", s.name());
-    write_labels(w, s, j);
-    w.str("error", out.error);
-    w.strings("warnings", warnings);
-    w.str("canonical", j.canonical);
-    w.num("started_unix", tm.started);
-    w.num("failed_unix", unix_now());
-    w.str("host", tm.host);
-    w.str("status", "failed");
-    w.end_object();
-    write_file_atomic(failure_file(s, j.index), w.text());
+    write_file_atomic(failure_file(s, j.index), failure_json(s, j, out.error, warnings, tm));
     return out;
   }
   fs::remove(failure_file(s, j.index), ec);
