@@ -1,6 +1,9 @@
-// `wheelins live`: navigate a stream of IMU records as they arrive (standard input) and
-// publish the vehicle's state (run/live_stream.hpp; docs/live.md).
+// `wheelins live`: navigate a stream of IMU records as they arrive (standard input or UDP
+// datagrams on localhost) and publish the vehicle's state (run/live_stream.hpp; docs/live.md).
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <poll.h>
+#include <sys/socket.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -8,6 +11,7 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +19,8 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "cli.hpp"
 #include "wheelins/io/text_util.hpp"
@@ -27,7 +33,8 @@ using namespace wheelins;
 
 struct LiveArgs {
   std::string config_file, manifest, configuration, chips, modules, out, formats, calibration, format = "json";
-  double warmup = 120.0, window = 0.05, publish_interval = 0.1;
+  double warmup = 120.0, window = 0.05, publish_interval = 0.1, idle_exit = 0.0;
+  std::optional<int> udp_port;  // none: standard input
   std::optional<double> duration;
   bool centralized = false, no_faults = false, fixed_noise = false, force = false, full_rate = false;
 };
@@ -38,11 +45,16 @@ double now_seconds() {
 
 /// Lines of a file descriptor as they arrive, read with read(2) and a poll of 0.1 s, so that a
 /// signal is seen within that time whichever thread the kernel hands it to (the run's writer
-/// runs on a thread of its own) and stdio's buffering does not hold lines back.
+/// runs on a thread of its own) and stdio's buffering does not hold lines back. On a datagram
+/// socket each datagram holds whole lines (its end ends a line; an empty one is ignored) and
+/// there is no end of input: `idle_exit` (> 0) seconds without input end it, for both.
 class LineReader {
  public:
   enum Got { kLine, kNothing, kEnd };
-  explicit LineReader(int fd) : fd_(fd) { buf_.reserve(1 << 16); }
+  LineReader(int fd, std::string name, bool datagrams, double idle_exit)
+      : fd_(fd), name_(std::move(name)), datagrams_(datagrams), idle_exit_(idle_exit), read_time_(now_seconds()) {
+    buf_.reserve(1 << 17);
+  }
   /// kLine: `line` (valid until the next call) and `arrival`, the steady-clock time of the read
   /// that completed it; kNothing: no whole line within 0.1 s; kEnd: the end of input.
   Got next(std::string_view& line, double& arrival) {
@@ -61,27 +73,68 @@ class LineReader {
       pollfd p{fd_, POLLIN, 0};
       const int ready = ::poll(&p, 1, 100);
       if (ready <= 0) {
-        if (ready < 0 && errno != EINTR) throw InputError(std::string("standard input: ") + std::strerror(errno));
-        return kNothing;
+        if (ready < 0 && errno != EINTR) throw InputError(name_ + ": " + std::strerror(errno));
+        if (idle_exit_ > 0.0 && now_seconds() - read_time_ > idle_exit_) {
+          std::fprintf(stderr, "wheelins live: no input on %s for %g s (--idle-exit): the run ends here\n",
+                       name_.c_str(), idle_exit_);
+          eof_ = true;
+        }
+        if (!eof_) return kNothing;
+        continue;
       }
-      char chunk[1 << 14];
-      const ssize_t n = ::read(fd_, chunk, sizeof chunk);
+      const ssize_t n = ::read(fd_, chunk_.data(), chunk_.size());
       if (n < 0) {
         if (errno == EINTR || errno == EAGAIN) return kNothing;
-        throw InputError(std::string("standard input: ") + std::strerror(errno));
+        throw InputError(name_ + ": " + std::strerror(errno));
       }
       read_time_ = now_seconds();
-      if (n == 0) eof_ = true;
-      buf_.append(chunk, static_cast<std::size_t>(n));
+      if (n == 0 && !datagrams_) eof_ = true;
+      buf_.append(chunk_.data(), static_cast<std::size_t>(n));
+      if (datagrams_ && n > 0 && buf_.back() != '\n') buf_ += '\n';
     }
   }
 
  private:
   int fd_;
+  std::string name_;
+  bool datagrams_;
+  double idle_exit_;
   std::string buf_;
+  std::vector<char> chunk_ = std::vector<char>(1 << 16);  // the largest UDP datagram whole
   std::size_t start_ = 0;
-  double read_time_ = 0.0;
+  double read_time_;
   bool eof_ = false;
+};
+
+/// A UDP socket bound to 127.0.0.1:`port` (localhost only: the stream carries no
+/// authentication), its receive buffer as large as the system allows (up to 4 MiB) so that a
+/// burst of datagrams waits for the navigation instead of being dropped.
+class UdpSocket {
+ public:
+  explicit UdpSocket(int port) {
+    if (port < 1 || port > 65535) throw InputError("--udp " + std::to_string(port) + ": a port in 1-65535");
+    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (fd_ < 0) throw InputError(std::string("--udp: socket: ") + std::strerror(errno));
+    const int want = 4 << 20;
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &want, sizeof want);  // capped by the system: best effort
+    sockaddr_in addr = {};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(port));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
+      const int e = errno;
+      ::close(fd_);
+      throw InputError("--udp " + std::to_string(port) + ": cannot listen on 127.0.0.1:" + std::to_string(port) +
+                       ": " + std::strerror(e));
+    }
+  }
+  UdpSocket(const UdpSocket&) = delete;
+  UdpSocket& operator=(const UdpSocket&) = delete;
+  ~UdpSocket() { ::close(fd_); }
+  int fd() const { return fd_; }
+
+ private:
+  int fd_ = -1;
 };
 
 extern "C" void on_stop(int sig) {
@@ -156,8 +209,13 @@ int live(const LiveArgs& a) {
     throw InputError("--format '" + a.format + "': json (JSON lines) or csv");
   if (!(a.warmup > 0.0 && a.warmup <= 3600.0))
     throw InputError("--calibration-warmup " + io_detail::format_double(a.warmup) + ": must be in (0, 3600] s");
+  if (!(a.idle_exit >= 0.0 && a.idle_exit <= 86400.0))
+    throw InputError("--idle-exit " + io_detail::format_double(a.idle_exit) + ": must be in [0, 86400] s (0: never)");
+  std::optional<UdpSocket> udp;
+  if (a.udp_port) udp.emplace(*a.udp_port);
+  const std::string source = udp ? "udp://127.0.0.1:" + std::to_string(*a.udp_port) : "standard input";
   const WarningSink warn = [](const std::string& w) { std::fprintf(stderr, "warning: %s\n", w.c_str()); };
-  PushSession session(live_request(a, warn), a.warmup, "standard input");
+  PushSession session(live_request(a, warn), a.warmup, source);
   LiveStreamOptions opt;
   opt.window = a.window;
   opt.publish_interval = a.publish_interval;
@@ -165,13 +223,15 @@ int live(const LiveArgs& a) {
   LiveStream stream(session, opt, stdout, stderr);
   std::string mods;
   for (const auto& m : session.request().modules) mods += (mods.empty() ? "" : ", ") + m;
-  std::fprintf(stderr, "wheelins live: %s on '%s'; reading `module, t, gx, gy, gz, ax, ay, az` lines from "
-                       "standard input (end of input or Ctrl-C ends the run)\n",
-               mods.c_str(), session.request().manifest.path.string().c_str());
+  std::fprintf(stderr, "wheelins live: %s on '%s'; reading `module, t, gx, gy, gz, ax, ay, az` lines from %s (%s)\n",
+               mods.c_str(), session.request().manifest.path.string().c_str(),
+               udp ? ("UDP datagrams on " + source.substr(6)).c_str() : "standard input",
+               udp ? (a.idle_exit > 0 ? "--idle-exit or Ctrl-C ends the run" : "Ctrl-C ends the run")
+                   : "end of input or Ctrl-C ends the run");
 
   catch_stop_signals();
   const double wall0 = now_seconds(), cpu0 = cpu_seconds();
-  LineReader in(STDIN_FILENO);
+  LineReader in(udp ? udp->fd() : STDIN_FILENO, source, udp.has_value(), a.idle_exit);
   std::string_view text;
   double arrival = 0.0;
   for (bool more = true; more && !interrupt_requested();) {
@@ -194,7 +254,7 @@ int live(const LiveArgs& a) {
 }
 
 const bool registered = cli::register_command(
-    25, "live", "Navigate IMU records as they arrive on standard input and publish the state",
+    25, "live", "Navigate IMU records as they arrive (standard input or UDP) and publish the state",
     [](CLI::App& sub) {
       auto a = std::make_shared<LiveArgs>();
       sub.add_option("config", a->config_file, "Run configuration (YAML; see docs/run-config.md)");
@@ -217,6 +277,11 @@ const bool registered = cli::register_command(
                      "Seconds of data the installation is estimated from (default 120); no state is "
                      "published before its end");
       sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
+      sub.add_option("--udp", a->udp_port,
+                     "Read the lines from UDP datagrams on 127.0.0.1:PORT instead of standard input (each "
+                     "datagram whole lines)");
+      sub.add_option("--idle-exit", a->idle_exit,
+                     "End the run when no input arrived for this many seconds (default 0: never)");
       sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
       sub.add_flag("--no-fault-handling", a->no_faults, "Use every sample and module as it comes");
       sub.add_flag("--fixed-noise", a->fixed_noise, "Hold the noise figures fixed");

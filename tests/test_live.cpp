@@ -1,8 +1,17 @@
 // `wheelins live`'s plain stream (issue 32): lines parsed, put back in order within the
 // window, and a simulated dataset piped through standard input giving the file run's
-// trajectory to the byte, also with bad input mixed in (which is reported and left out).
+// trajectory to the byte, also with bad input mixed in (which is reported and left out), and
+// the same through UDP datagrams on localhost.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdint>
 
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +33,34 @@ using namespace wheelins;
 namespace fs = std::filesystem;
 
 namespace {
+
+sockaddr_in localhost(int port) {
+  sockaddr_in a = {};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  return a;
+}
+
+/// A UDP port on localhost that nothing holds (bound and let go: the program binds it next).
+int free_udp_port() {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a = localhost(0);
+  socklen_t len = sizeof a;
+  const bool ok = ::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) == 0 &&
+                  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0;
+  ::close(fd);
+  return ok ? ntohs(a.sin_port) : -1;
+}
+
+/// Whether something holds UDP `port` on localhost.
+bool udp_port_taken(int port) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  const sockaddr_in a = localhost(port);
+  const bool taken = ::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0 && errno == EADDRINUSE;
+  ::close(fd);
+  return taken;
+}
 
 ImuRow row_at(double t) {
   ImuRow r;
@@ -247,6 +284,76 @@ TEST_F(LiveCliTest, PublishesCsvRowsAtTheAskedIntervalAndRefusesBadOptions) {
   const Cmd none = live({"# nothing but a comment"}, dir_->path() / "n");
   EXPECT_EQ(none.code, 2);
   EXPECT_NE(none.err.find("the data end before the static period"), std::string::npos) << none.err;
+}
+
+TEST_F(LiveCliTest, UdpDatagramsOnLocalhostGiveTheFileRunsTrajectory) {
+  const std::vector<std::string> text = lines("triple");
+  const fs::path out = dir_->path() / "udp";
+  const int port = free_udp_port();
+  ASSERT_GT(port, 0);
+  const std::string cmd = "exec '" + std::string(WHEELINS_BINARY) + "' live -m '" + manifest().string() +
+                          "' -c triple --calibration manifest --udp " + std::to_string(port) +
+                          " --idle-exit 2 -o '" + out.string() + "' >'" + out.string() + ".states' 2>'" +
+                          out.string() + ".err'";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  bool listening = false;
+  for (int k = 0; k < 600 && !listening; ++k) {
+    listening = udp_port_taken(port);
+    if (!listening) ::usleep(50000);
+  }
+  if (!listening) ::kill(pid, SIGKILL);
+  // 40 lines a datagram, every second one without its last newline (a datagram's end ends a
+  // line), paced at about 8,000 lines per second (a slower receiver under the sanitizers keeps
+  // up even where the system allows no large receive buffer); then 2 s of silence end the run.
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  const sockaddr_in to = localhost(port);
+  std::string datagram;
+  std::size_t sent = 0, datagrams = 0;
+  for (std::size_t k = 0; listening && k < text.size(); ++k) {
+    datagram += text[k];
+    datagram += '\n';
+    if ((k + 1) % 40 != 0 && k + 1 != text.size()) continue;
+    if (++datagrams % 2 == 0) datagram.pop_back();
+    if (::sendto(fd, datagram.data(), datagram.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to) ==
+        static_cast<ssize_t>(datagram.size()))
+      sent += (k % 40) + 1;
+    datagram.clear();
+    ::usleep(5000);
+  }
+  ::close(fd);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const std::string err = iotest::read_text_file(out.string() + ".err");
+  ASSERT_TRUE(listening) << "the program did not listen on port " << port << ": " << err;
+  ASSERT_EQ(sent, text.size());
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  ASSERT_EQ(WEXITSTATUS(status), 0) << err;
+  EXPECT_EQ(iotest::read_text_file(out / "trajectory.csv"), file_run_trajectory());
+  EXPECT_NE(err.find("UDP datagrams on 127.0.0.1:" + std::to_string(port)), std::string::npos) << err;
+  EXPECT_NE(err.find("no input on udp://127.0.0.1:" + std::to_string(port) + " for 2 s (--idle-exit)"),
+            std::string::npos) << err;
+  EXPECT_NE(err.find("wheelins live: " + std::to_string(text.size()) + " lines"), std::string::npos) << err;
+  EXPECT_NE(err.find("left out: 0 unreadable or not navigated, 0 late, 0 refused"), std::string::npos) << err;
+
+  // A port out of range, a port already held (by this test), a negative idle time: refused.
+  const fs::path bad = dir_->path() / "udp-bad";
+  for (const std::string& opt : {std::string("--udp 70000"), std::string("--idle-exit -1")}) {
+    const Cmd c = live({}, bad, opt);
+    EXPECT_EQ(c.code, 2) << opt << ": " << c.err;
+    EXPECT_NE(c.err.find(opt.substr(0, opt.find(' '))), std::string::npos) << c.err;
+  }
+  const int holder = ::socket(AF_INET, SOCK_DGRAM, 0);
+  const sockaddr_in held = localhost(port);
+  ASSERT_EQ(::bind(holder, reinterpret_cast<const sockaddr*>(&held), sizeof held), 0);
+  const Cmd c = live({}, bad, "--udp " + std::to_string(port));
+  ::close(holder);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("cannot listen on 127.0.0.1:" + std::to_string(port)), std::string::npos) << c.err;
 }
 
 TEST_F(LiveCliTest, ASignalEndsTheRunAsTheEndOfInputDoesAndTheFilesAreWritten) {
