@@ -204,6 +204,17 @@ void print_summary(const LiveStreamStats& st, const RunResult& res, double wall,
                  res.files.front().parent_path().string().c_str());
 }
 
+/// The start-up line (printed once the input is open: a UDP port is bound by then).
+void print_start(const RunRequest& request, const std::string& from, bool udp, bool idle_exit) {
+  std::string mods;
+  for (const auto& m : request.modules) mods += (mods.empty() ? "" : ", ") + m;
+  const char* ends = !udp ? "end of input or Ctrl-C ends the run"
+                     : idle_exit ? "--idle-exit or Ctrl-C ends the run"
+                                 : "Ctrl-C ends the run";
+  std::fprintf(stderr, "wheelins live: %s on '%s'; reading `module, t, gx, gy, gz, ax, ay, az` lines from %s (%s)\n",
+               mods.c_str(), request.manifest.path.string().c_str(), from.c_str(), ends);
+}
+
 int live(const LiveArgs& a) {
   if (a.format != "json" && a.format != "csv")
     throw InputError("--format '" + a.format + "': json (JSON lines) or csv");
@@ -221,13 +232,8 @@ int live(const LiveArgs& a) {
   opt.publish_interval = a.publish_interval;
   opt.csv = a.format == "csv";
   LiveStream stream(session, opt, stdout, stderr);
-  std::string mods;
-  for (const auto& m : session.request().modules) mods += (mods.empty() ? "" : ", ") + m;
-  std::fprintf(stderr, "wheelins live: %s on '%s'; reading `module, t, gx, gy, gz, ax, ay, az` lines from %s (%s)\n",
-               mods.c_str(), session.request().manifest.path.string().c_str(),
-               udp ? ("UDP datagrams on " + source.substr(6)).c_str() : "standard input",
-               udp ? (a.idle_exit > 0 ? "--idle-exit or Ctrl-C ends the run" : "Ctrl-C ends the run")
-                   : "end of input or Ctrl-C ends the run");
+  print_start(session.request(), udp ? "UDP datagrams on " + source.substr(6) : source, udp.has_value(),
+              a.idle_exit > 0);
 
   catch_stop_signals();
   const double wall0 = now_seconds(), cpu0 = cpu_seconds();

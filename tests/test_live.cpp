@@ -9,10 +9,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <csignal>
 #include <cstdint>
-
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -53,13 +51,13 @@ int free_udp_port() {
   return ok ? ntohs(a.sin_port) : -1;
 }
 
-/// Whether something holds UDP `port` on localhost.
-bool udp_port_taken(int port) {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  const sockaddr_in a = localhost(port);
-  const bool taken = ::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0 && errno == EADDRINUSE;
-  ::close(fd);
-  return taken;
+/// Whether the program has said that it listens on `port` (it says so once the port is bound;
+/// probing by binding the port ourselves could take it from the program).
+bool says_it_listens(const fs::path& err, int port) {
+  std::ifstream f(err);
+  std::stringstream text;
+  text << f.rdbuf();
+  return text.str().find("UDP datagrams on 127.0.0.1:" + std::to_string(port)) != std::string::npos;
 }
 
 ImuRow row_at(double t) {
@@ -303,7 +301,7 @@ TEST_F(LiveCliTest, UdpDatagramsOnLocalhostGiveTheFileRunsTrajectory) {
   }
   bool listening = false;
   for (int k = 0; k < 600 && !listening; ++k) {
-    listening = udp_port_taken(port);
+    listening = says_it_listens(out.string() + ".err", port);
     if (!listening) ::usleep(50000);
   }
   if (!listening) ::kill(pid, SIGKILL);
