@@ -117,128 +117,168 @@ std::vector<ExperimentRun> experiment_plan(const Manifest& m, const ExperimentOp
   return plan;
 }
 
-std::string experiment_markdown(const ExperimentResult& r) {
-  std::ostringstream o;
-  auto runs_of = [&](const std::string& config, bool centralized) {
-    std::vector<const ExperimentRun*> v;
-    for (const auto& run : r.runs)
-      if (run.configuration == config && run.centralized == centralized) v.push_back(&run);
-    return v;
-  };
-  auto pct = [](const ExperimentRun* x) { return 100.0 * x->eval.drift_rate; };
-  auto deg = [](const ExperimentRun* x) { return x->eval.heading_rmse / kDeg; };
+namespace {
 
+using Runs = std::vector<const ExperimentRun*>;
+
+Runs runs_of(const ExperimentResult& r, const std::string& config, bool centralized) {
+  Runs v;
+  for (const auto& run : r.runs)
+    if (run.configuration == config && run.centralized == centralized) v.push_back(&run);
+  return v;
+}
+
+double pct(const ExperimentRun* x) { return 100.0 * x->eval.drift_rate; }
+double deg(const ExperimentRun* x) { return x->eval.heading_rmse / kDeg; }
+
+/// The runs of each table's configurations, in the plan's order.
+struct ConfigRuns {
+  Runs singles, dw, bw, tw, cent;
+};
+
+void markdown_header(std::ostream& o, const ExperimentResult& r) {
   o << "# Experiment: " << (r.dataset_name.empty() ? r.manifest.string() : r.dataset_name) << "\n\n"
     << "Dataset `" << r.manifest.string() << "`; " << r.runs.size() << " runs in "
     << fmt(r.wall_seconds, 1) << " s. Each run navigates "
     << (r.duration > 0.0 ? fmt(r.duration, 1) + " s after the static period (--duration)"
                          : std::string("all the data (no --duration)"))
     << ". Drift rate: paper Section VI-B (l = 100 m), in % of distance; heading RMSE in degrees.\n\n";
+}
 
-  // Table 4
-  const auto singles = runs_of("single", false);
-  if (!singles.empty()) {
-    o << "## Table 4: single Wheel-INS\n\n| Test |";
-    for (const auto* s : singles) o << " " << (s->side == "left" ? "L" : "R") << " C" << s->label << " |";
-    o << "\n|---|";
-    for (std::size_t k = 0; k < singles.size(); ++k) o << "---|";
-    o << "\n| Drift rate (%) |";
-    for (const auto* s : singles) o << " " << fmt(pct(s), 2) << " |";
-    o << "\n| Heading RMSE (deg) |";
-    for (const auto* s : singles) o << " " << fmt(deg(s), 2) << " |";
-    o << "\n\n";
-  }
+// Table 4
+void table4(std::ostream& o, const Runs& singles) {
+  if (singles.empty()) return;
+  o << "## Table 4: single Wheel-INS\n\n| Test |";
+  for (const auto* s : singles) o << " " << (s->side == "left" ? "L" : "R") << " C" << s->label << " |";
+  o << "\n|---|";
+  for (std::size_t k = 0; k < singles.size(); ++k) o << "---|";
+  o << "\n| Drift rate (%) |";
+  for (const auto* s : singles) o << " " << fmt(pct(s), 2) << " |";
+  o << "\n| Heading RMSE (deg) |";
+  for (const auto* s : singles) o << " " << fmt(deg(s), 2) << " |";
+  o << "\n\n";
+}
 
-  // Table 5
-  const auto dw = runs_of("dual-wheel", false), bw = runs_of("body-wheel", false),
-             tw = runs_of("triple", false);
-  const std::size_t n5 = std::max({dw.size(), bw.size(), tw.size()});
-  if (n5 > 0) {
-    o << "## Table 5: Dual Wheel-INS (DW), Body/Wheel-INS (BW), Triple INS (TW)\n\n"
-      << "Chips: DW left/right, BW left/body, TW left/right/body. Best of a row in bold.\n\n"
-      << "| Test | DW chips | BW chips | TW chips | DW drift (%) | BW drift (%) | TW drift (%) | "
-         "DW heading (deg) | BW heading (deg) | TW heading (deg) |\n"
-      << "|---|---|---|---|---|---|---|---|---|---|\n";
-    auto at = [](const std::vector<const ExperimentRun*>& v, std::size_t i) {
-      return i < v.size() ? v[i] : nullptr;
-    };
-    for (std::size_t i = 0; i < n5; ++i) {
-      const ExperimentRun* row[3] = {at(dw, i), at(bw, i), at(tw, i)};
-      o << "| " << i + 1 << " |";
-      for (const auto* x : row) o << " " << (x ? x->label : "-") << " |";
-      for (int metric = 0; metric < 2; ++metric) {
-        double best = INFINITY;
-        for (const auto* x : row)
-          if (x) best = std::min(best, metric == 0 ? pct(x) : deg(x));
-        for (const auto* x : row) {
-          if (!x) {
-            o << " - |";
-            continue;
-          }
-          const double v = metric == 0 ? pct(x) : deg(x);
-          const std::string t = fmt(v, 2);
-          o << " " << (v == best ? "**" + t + "**" : t) << " |";
-        }
-      }
-      o << "\n";
+/// One metric's cells of a Table 5 row, the best in bold; "-" for a missing run.
+void table5_cells(std::ostream& o, const ExperimentRun* const (&row)[3],
+                  double (*metric)(const ExperimentRun*)) {
+  double best = INFINITY;
+  for (const auto* x : row)
+    if (x) best = std::min(best, metric(x));
+  for (const auto* x : row) {
+    if (!x) {
+      o << " - |";
+      continue;
     }
+    const double v = metric(x);
+    const std::string t = fmt(v, 2);
+    o << " " << (v == best ? "**" + t + "**" : t) << " |";
+  }
+}
+
+// Table 5
+void table5(std::ostream& o, const ConfigRuns& c) {
+  const std::size_t n5 = std::max({c.dw.size(), c.bw.size(), c.tw.size()});
+  if (n5 == 0) return;
+  o << "## Table 5: Dual Wheel-INS (DW), Body/Wheel-INS (BW), Triple INS (TW)\n\n"
+    << "Chips: DW left/right, BW left/body, TW left/right/body. Best of a row in bold.\n\n"
+    << "| Test | DW chips | BW chips | TW chips | DW drift (%) | BW drift (%) | TW drift (%) | "
+       "DW heading (deg) | BW heading (deg) | TW heading (deg) |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|\n";
+  auto at = [](const Runs& v, std::size_t i) { return i < v.size() ? v[i] : nullptr; };
+  for (std::size_t i = 0; i < n5; ++i) {
+    const ExperimentRun* const row[3] = {at(c.dw, i), at(c.bw, i), at(c.tw, i)};
+    o << "| " << i + 1 << " |";
+    for (const auto* x : row) o << " " << (x ? x->label : "-") << " |";
+    table5_cells(o, row, pct);
+    table5_cells(o, row, deg);
     o << "\n";
   }
+  o << "\n";
+}
 
-  // Table 6
+// Table 6
+void table6(std::ostream& o, const ConfigRuns& c) {
   o << "## Table 6: all configurations (mean and standard deviation over the runs)\n\n"
     << "| Configuration | runs | drift MEAN (%) | drift STD (%) | heading MEAN (deg) | heading STD "
        "(deg) | within 3 sigma (%) |\n|---|---|---|---|---|---|---|\n";
-  const std::pair<const char*, std::vector<const ExperimentRun*>> rows6[] = {
-      {"Wheel-INS", singles}, {"Dual Wheel-INS", dw}, {"Body/Wheel-INS", bw}, {"Triple INS", tw},
-      {"Triple INS (centralized)", runs_of("triple", true)}};
+  const std::pair<const char*, const Runs*> rows6[] = {
+      {"Wheel-INS", &c.singles}, {"Dual Wheel-INS", &c.dw}, {"Body/Wheel-INS", &c.bw}, {"Triple INS", &c.tw},
+      {"Triple INS (centralized)", &c.cent}};
   for (const auto& [name, v] : rows6) {
-    if (v.empty()) continue;
-    std::vector<double> d, h, c;
-    for (const auto* x : v) {
+    if (v->empty()) continue;
+    std::vector<double> d, h, w;
+    for (const auto* x : *v) {
       d.push_back(pct(x));
       h.push_back(deg(x));
-      c.push_back(100.0 * x->eval.within_3sigma);
+      w.push_back(100.0 * x->eval.within_3sigma);
     }
-    o << "| " << name << " | " << v.size() << " | " << fmt(mean(d), 3) << " | " << fmt(stddev(d), 3)
-      << " | " << fmt(mean(h), 3) << " | " << fmt(stddev(h), 3) << " | " << fmt(mean(c), 1) << " |\n";
+    o << "| " << name << " | " << v->size() << " | " << fmt(mean(d), 3) << " | " << fmt(stddev(d), 3)
+      << " | " << fmt(mean(h), 3) << " | " << fmt(stddev(h), 3) << " | " << fmt(mean(w), 1) << " |\n";
   }
   o << "\n";
+}
 
-  // Tables 7 and 8
-  const auto cent = runs_of("triple", true);
-  if (!cent.empty()) {
-    o << "## Table 7: Triple INS, distributed vs centralized filter\n\n"
-      << "| Test | chips | drift distributed (%) | drift centralized (%) | heading distributed "
-         "(deg) | heading centralized (deg) |\n|---|---|---|---|---|---|\n";
-    std::vector<double> vd, vc, pd, pc, ed, ec;
-    for (std::size_t i = 0; i < cent.size(); ++i) {
-      const ExperimentRun* c = cent[i];
-      const ExperimentRun* d = nullptr;
-      for (const auto* x : tw)
-        if (x->label == c->label) d = x;
-      o << "| " << i + 1 << " | " << c->label << " | " << (d ? fmt(pct(d), 2) : "-") << " | "
-        << fmt(pct(c), 2) << " | " << (d ? fmt(deg(d), 2) : "-") << " | " << fmt(deg(c), 2) << " |\n";
-      auto timing = [](const ExperimentRun* x, std::vector<double>& v, std::vector<double>& p,
-                       std::vector<double>& e) {
-        const NavigatorStats& s = x->stats;
-        if (s.velocity_steps) v.push_back(1e6 * s.velocity_step_seconds / s.velocity_steps);
-        if (s.position_steps) p.push_back(1e6 * s.position_step_seconds / s.position_steps);
-        if (s.epochs) e.push_back(1e6 * x->filter_seconds / s.epochs);
-      };
-      if (d) timing(d, vd, pd, ed);
-      timing(c, vc, pc, ec);
-    }
-    o << "\n## Table 8: running time of the Triple INS (microseconds, this machine)\n\n"
-      << "Velocity update: all three subsystems' velocity/NHC updates at one epoch; position "
-         "update: the multi-IMU constraint for all three; per epoch: the whole filter time "
-         "(mechanization, covariance, updates, output) divided by the epochs of one IMU. "
-         "Means over the runs above; runs share the machine's cores.\n\n"
-      << "| Vel. update dist. | Vel. update cent. | Pos. update dist. | Pos. update cent. | "
-         "Per epoch dist. | Per epoch cent. |\n|---|---|---|---|---|---|\n"
-      << "| " << fmt(mean(vd), 1) << " | " << fmt(mean(vc), 1) << " | " << fmt(mean(pd), 1) << " | "
-      << fmt(mean(pc), 1) << " | " << fmt(mean(ed), 1) << " | " << fmt(mean(ec), 1) << " |\n\n";
+/// Per-run step times of Table 8 [microseconds].
+struct Timings {
+  std::vector<double> velocity, position, epoch;
+};
+
+void add_timing(const ExperimentRun* x, Timings& t) {
+  const NavigatorStats& s = x->stats;
+  if (s.velocity_steps) t.velocity.push_back(1e6 * s.velocity_step_seconds / s.velocity_steps);
+  if (s.position_steps) t.position.push_back(1e6 * s.position_step_seconds / s.position_steps);
+  if (s.epochs) t.epoch.push_back(1e6 * x->filter_seconds / s.epochs);
+}
+
+void table8(std::ostream& o, const Timings& dist, const Timings& cent) {
+  o << "\n## Table 8: running time of the Triple INS (microseconds, this machine)\n\n"
+    << "Velocity update: all three subsystems' velocity/NHC updates at one epoch; position "
+       "update: the multi-IMU constraint for all three; per epoch: the whole filter time "
+       "(mechanization, covariance, updates, output) divided by the epochs of one IMU. "
+       "Means over the runs above; runs share the machine's cores.\n\n"
+    << "| Vel. update dist. | Vel. update cent. | Pos. update dist. | Pos. update cent. | "
+       "Per epoch dist. | Per epoch cent. |\n|---|---|---|---|---|---|\n"
+    << "| " << fmt(mean(dist.velocity), 1) << " | " << fmt(mean(cent.velocity), 1) << " | "
+    << fmt(mean(dist.position), 1) << " | " << fmt(mean(cent.position), 1) << " | " << fmt(mean(dist.epoch), 1)
+    << " | " << fmt(mean(cent.epoch), 1) << " |\n\n";
+}
+
+// Tables 7 and 8
+void tables7_8(std::ostream& o, const ConfigRuns& runs) {
+  if (runs.cent.empty()) return;
+  o << "## Table 7: Triple INS, distributed vs centralized filter\n\n"
+    << "| Test | chips | drift distributed (%) | drift centralized (%) | heading distributed "
+       "(deg) | heading centralized (deg) |\n|---|---|---|---|---|---|\n";
+  Timings dist, cent;
+  for (std::size_t i = 0; i < runs.cent.size(); ++i) {
+    const ExperimentRun* c = runs.cent[i];
+    const ExperimentRun* d = nullptr;
+    for (const auto* x : runs.tw)
+      if (x->label == c->label) d = x;
+    o << "| " << i + 1 << " | " << c->label << " | " << (d ? fmt(pct(d), 2) : "-") << " | "
+      << fmt(pct(c), 2) << " | " << (d ? fmt(deg(d), 2) : "-") << " | " << fmt(deg(c), 2) << " |\n";
+    if (d) add_timing(d, dist);
+    add_timing(c, cent);
   }
+  table8(o, dist, cent);
+}
+
+}  // namespace
+
+std::string experiment_markdown(const ExperimentResult& r) {
+  std::ostringstream o;
+  ConfigRuns runs;
+  runs.singles = runs_of(r, "single", false);
+  runs.dw = runs_of(r, "dual-wheel", false);
+  runs.bw = runs_of(r, "body-wheel", false);
+  runs.tw = runs_of(r, "triple", false);
+  runs.cent = runs_of(r, "triple", true);
+  markdown_header(o, r);
+  table4(o, runs.singles);
+  table5(o, runs);
+  table6(o, runs);
+  tables7_8(o, runs);
   return o.str();
 }
 

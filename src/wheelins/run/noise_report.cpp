@@ -43,6 +43,86 @@ void consistency(std::ostringstream& o, const char* name, const MeasurementConsi
     << ", rejected: " << c.rejected << "}\n";
 }
 
+/// The figures the run started from, with where each came from.
+void given_section(std::ostringstream& o, const ModuleNoiseReport& r, const ModuleSpec* s) {
+  o << "    given:\n";
+  o << "      gyro_arw_deg_sqrt_h: " << num(arw_h(r.given.gyro_arw)) << "  # " << source(s, kNoiseArw) << "\n";
+  o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.given.acc_vrw)) << "  # " << source(s, kNoiseVrw) << "\n";
+  o << "      gyro_bias_deg_h: " << num(deg_h(r.given.gyro_bias_std)) << "  # " << source(s, kNoiseGyroBias) << "\n";
+  o << "      acc_bias_m_s2: " << num(r.given.acc_bias_std) << "  # " << source(s, kNoiseAccBias) << "\n";
+  o << "      gyro_sf_ppm: " << num(r.given.gyro_sf_std * 1e6) << "  # " << source(s, kNoiseGyroSf) << "\n";
+  o << "      acc_sf_ppm: " << num(r.given.acc_sf_std * 1e6) << "  # " << source(s, kNoiseAccSf) << "\n";
+  o << "      velocity_std_m_s: " << vec(r.velocity_std_given) << "  # the run's filter setting\n";
+}
+
+/// The Allan variance of the static period, or null without one.
+void at_rest_section(std::ostringstream& o, const ModuleNoiseReport& r) {
+  if (r.gyro_rest.valid) {
+    o << "    at_rest:  # " << num(r.gyro_rest.duration, 4) << " s of static data\n";
+    o << "      gyro_arw_deg_sqrt_h: " << num(arw_h(r.gyro_rest.white)) << "  # per axis "
+      << vec(r.gyro_rest.white_axes / kDeg * 60.0) << "\n";
+    o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.accel_rest.white)) << "  # per axis "
+      << vec(r.accel_rest.white_axes * 60.0) << "\n";
+    o << "      gyro_bias_instability_deg_h: " << num(deg_h(r.gyro_rest.bias_instability))
+      << "  # " << (r.gyro_rest.floor_reached ? "Allan minimum at " : "an upper bound: still falling at ")
+      << num(r.gyro_rest.bias_tau, 3) << " s\n";
+    o << "      acc_bias_instability_m_s2: " << num(r.accel_rest.bias_instability)
+      << "  # " << (r.accel_rest.floor_reached ? "Allan minimum at " : "an upper bound: still falling at ")
+      << num(r.accel_rest.bias_tau, 3) << " s\n";
+    o << "      gyro_bias_after_alignment_deg_h: " << num(deg_h(r.gyro_bias_start_sigma))
+      << "  # 1 sigma of the aligned bias\n";
+  } else {
+    o << "    at_rest: null  # too few static samples for the Allan variance\n";
+  }
+}
+
+/// What the velocity innovations showed, and the figures in use at the end.
+void in_motion_and_used_sections(std::ostringstream& o, const ModuleNoiseReport& r) {
+  o << "    in_motion:\n";
+  o << "      estimated: " << (r.adapted ? "true" : "false") << "\n";
+  o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.vrw)) << "  # started from " << num(vrw_h(r.vrw_start)) << "\n";
+  o << "      velocity_std_m_s: " << vec(r.velocity_std) << "  # speed, lateral, vertical\n";
+  o << "      innovation_ratio: " << vec(r.nis_axes, 3)
+    << "  # mean dz^2 / predicted per axis over the last window (1 if consistent)\n";
+  o << "    used:\n";
+  o << "      gyro_arw_deg_sqrt_h: " << num(arw_h(r.arw)) << "\n";
+  o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.vrw)) << "\n";
+  o << "      gyro_bias_deg_h: " << num(deg_h(r.gyro_bias_instability)) << "  # in-run instability\n";
+}
+
+/// The states held or estimated from the constraint only, and the estimates beyond 3 sigma.
+void state_sections(std::ostringstream& o, const ModuleNoiseReport& r) {
+  o << "    not_estimated: [";
+  for (std::size_t k = 0; k < r.held.size(); ++k) o << (k ? ", " : "") << error_state_name(r.held[k]);
+  o << "]  # held at 0 (docs/filter.md 13.4: yaw-rate scale factors, the axle accelerometer's)\n";
+  o << "    from_constraint_only: [";
+  for (std::size_t k = 0; k < r.constraint_only.size(); ++k)
+    o << (k ? ", " : "") << error_state_name(r.constraint_only[k]);
+  o << "]  # estimated from the position constraint, not the velocity updates (13.4)\n";
+  o << "    beyond_3_sigma:";
+  if (r.excursions.empty()) o << " []";
+  o << "\n";
+  for (const PriorExcursion& x : r.excursions) {
+    const bool gb = x.state >= BG && x.state < BG + 3, ab = x.state >= BA && x.state < BA + 3;
+    const double u = gb ? 3600.0 / kDeg : (ab ? 1.0 : 1e6);
+    o << "      - {state: " << error_state_name(x.state) << ", t_s: " << num(x.t, 10) << ", value: "
+      << num(x.value * u) << ", prior_sigma: " << num(x.prior_sigma * u) << ", unit: "
+      << (gb ? "deg/h" : (ab ? "m/s^2" : "ppm")) << "}\n";
+  }
+}
+
+/// The module's warnings, quoted.
+void warnings_section(std::ostringstream& o, const ModuleNoiseReport& r) {
+  o << "    warnings:";
+  if (r.warnings.empty()) o << " []";
+  o << "\n";
+  for (const std::string& w : r.warnings) {
+    std::string q;
+    for (char c : w) q += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+    o << "      - \"" << q << "\"\n";
+  }
+}
+
 }  // namespace
 
 std::string noise_report_yaml(const std::vector<ModuleNoiseReport>& reports,
@@ -58,72 +138,16 @@ std::string noise_report_yaml(const std::vector<ModuleNoiseReport>& reports,
   o << "adapted: " << (adapted ? "true" : "false") << "  # false: the given figures were held fixed\n";
   o << "modules:\n";
   for (const ModuleNoiseReport& r : reports) {
-    const ModuleSpec* s = spec_of(manifest, r.module);
     o << "  - name: \"" << r.module << "\"\n";
     o << "    kind: " << (r.wheel ? "wheel" : "body") << "\n";
-    o << "    given:\n";
-    o << "      gyro_arw_deg_sqrt_h: " << num(arw_h(r.given.gyro_arw)) << "  # " << source(s, kNoiseArw) << "\n";
-    o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.given.acc_vrw)) << "  # " << source(s, kNoiseVrw) << "\n";
-    o << "      gyro_bias_deg_h: " << num(deg_h(r.given.gyro_bias_std)) << "  # " << source(s, kNoiseGyroBias) << "\n";
-    o << "      acc_bias_m_s2: " << num(r.given.acc_bias_std) << "  # " << source(s, kNoiseAccBias) << "\n";
-    o << "      gyro_sf_ppm: " << num(r.given.gyro_sf_std * 1e6) << "  # " << source(s, kNoiseGyroSf) << "\n";
-    o << "      acc_sf_ppm: " << num(r.given.acc_sf_std * 1e6) << "  # " << source(s, kNoiseAccSf) << "\n";
-    o << "      velocity_std_m_s: " << vec(r.velocity_std_given) << "  # the run's filter setting\n";
-    if (r.gyro_rest.valid) {
-      o << "    at_rest:  # " << num(r.gyro_rest.duration, 4) << " s of static data\n";
-      o << "      gyro_arw_deg_sqrt_h: " << num(arw_h(r.gyro_rest.white)) << "  # per axis "
-        << vec(r.gyro_rest.white_axes / kDeg * 60.0) << "\n";
-      o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.accel_rest.white)) << "  # per axis "
-        << vec(r.accel_rest.white_axes * 60.0) << "\n";
-      o << "      gyro_bias_instability_deg_h: " << num(deg_h(r.gyro_rest.bias_instability))
-        << "  # " << (r.gyro_rest.floor_reached ? "Allan minimum at " : "an upper bound: still falling at ")
-        << num(r.gyro_rest.bias_tau, 3) << " s\n";
-      o << "      acc_bias_instability_m_s2: " << num(r.accel_rest.bias_instability)
-        << "  # " << (r.accel_rest.floor_reached ? "Allan minimum at " : "an upper bound: still falling at ")
-        << num(r.accel_rest.bias_tau, 3) << " s\n";
-      o << "      gyro_bias_after_alignment_deg_h: " << num(deg_h(r.gyro_bias_start_sigma))
-        << "  # 1 sigma of the aligned bias\n";
-    } else {
-      o << "    at_rest: null  # too few static samples for the Allan variance\n";
-    }
-    o << "    in_motion:\n";
-    o << "      estimated: " << (r.adapted ? "true" : "false") << "\n";
-    o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.vrw)) << "  # started from " << num(vrw_h(r.vrw_start)) << "\n";
-    o << "      velocity_std_m_s: " << vec(r.velocity_std) << "  # speed, lateral, vertical\n";
-    o << "      innovation_ratio: " << vec(r.nis_axes, 3)
-      << "  # mean dz^2 / predicted per axis over the last window (1 if consistent)\n";
-    o << "    used:\n";
-    o << "      gyro_arw_deg_sqrt_h: " << num(arw_h(r.arw)) << "\n";
-    o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.vrw)) << "\n";
-    o << "      gyro_bias_deg_h: " << num(deg_h(r.gyro_bias_instability)) << "  # in-run instability\n";
+    given_section(o, r, spec_of(manifest, r.module));
+    at_rest_section(o, r);
+    in_motion_and_used_sections(o, r);
     o << "    consistency:\n";
     consistency(o, "velocity", r.velocity);
     consistency(o, "position", r.position);
-    o << "    not_estimated: [";
-    for (std::size_t k = 0; k < r.held.size(); ++k) o << (k ? ", " : "") << error_state_name(r.held[k]);
-    o << "]  # held at 0 (docs/filter.md 13.4: yaw-rate scale factors, the axle accelerometer's)\n";
-    o << "    from_constraint_only: [";
-    for (std::size_t k = 0; k < r.constraint_only.size(); ++k)
-      o << (k ? ", " : "") << error_state_name(r.constraint_only[k]);
-    o << "]  # estimated from the position constraint, not the velocity updates (13.4)\n";
-    o << "    beyond_3_sigma:";
-    if (r.excursions.empty()) o << " []";
-    o << "\n";
-    for (const PriorExcursion& x : r.excursions) {
-      const bool gb = x.state >= BG && x.state < BG + 3, ab = x.state >= BA && x.state < BA + 3;
-      const double u = gb ? 3600.0 / kDeg : (ab ? 1.0 : 1e6);
-      o << "      - {state: " << error_state_name(x.state) << ", t_s: " << num(x.t, 10) << ", value: "
-        << num(x.value * u) << ", prior_sigma: " << num(x.prior_sigma * u) << ", unit: "
-        << (gb ? "deg/h" : (ab ? "m/s^2" : "ppm")) << "}\n";
-    }
-    o << "    warnings:";
-    if (r.warnings.empty()) o << " []";
-    o << "\n";
-    for (const std::string& w : r.warnings) {
-      std::string q;
-      for (char c : w) q += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-      o << "      - \"" << q << "\"\n";
-    }
+    state_sections(o, r);
+    warnings_section(o, r);
   }
   return o.str();
 }

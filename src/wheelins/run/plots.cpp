@@ -247,10 +247,8 @@ void add_error_figure(Output& out, const ExperimentResult& r, const std::string&
   out.plots.push_back(name);
 }
 
-/// Truth path and the figure runs' tracks.
-void add_trajectory(Output& out, const ExperimentResult& r, const TruthData& truth,
-                    const earth::LocalFrame& frame) {
-  const std::string name = "trajectory";
+/// The runs the trajectory plot draws: the figure runs with a kept track, then a single Wheel-INS.
+std::vector<const ExperimentRun*> track_runs(const ExperimentResult& r) {
   std::vector<const ExperimentRun*> runs;
   for (const char* config : {"dual-wheel", "body-wheel", "triple"}) {
     for (const auto& run : r.runs)
@@ -267,10 +265,33 @@ void add_trajectory(Output& out, const ExperimentResult& r, const TruthData& tru
         (!single || (dw && run.modules == std::vector<std::string>{dw->modules[0]})))
       single = &run;
   if (single) runs.push_back(single);
-  if (runs.empty()) {
-    out.notes.push_back(name + ".png not drawn: no run with a kept track in this experiment");
-    return;
+  return runs;
+}
+
+/// The trajectory plot as it is put together: its plot commands and the east/north extent
+/// of the points drawn.
+struct TrackPlot {
+  explicit TrackPlot(const earth::LocalFrame& f) : frame(f) {}
+
+  /// `lla` in the local frame, the extent grown to hold it.
+  Vec3 point(const earth::Geodetic& lla) {
+    const Vec3 p = frame.ned_from_geodetic(lla);
+    e_lo = std::min(e_lo, p.y());
+    e_hi = std::max(e_hi, p.y());
+    n_lo = std::min(n_lo, p.x());
+    n_hi = std::max(n_hi, p.x());
+    return p;
   }
+
+  const earth::LocalFrame& frame;
+  std::vector<std::string> parts;  ///< plot commands, in drawing order
+  double e_lo = std::numeric_limits<double>::infinity(), e_hi = -e_lo, n_lo = e_lo, n_hi = -e_lo;
+};
+
+/// data/truth.csv over the runs' time span (and a second either side), with the start marked;
+/// false when the truth has no record there.
+bool add_truth_path(Output& out, TrackPlot& plot, const TruthData& truth,
+                    const std::vector<const ExperimentRun*>& runs) {
   double t_lo = std::numeric_limits<double>::infinity(), t_hi = -t_lo;
   for (const auto* run : runs) {
     t_lo = std::min(t_lo, run->track.front().t);
@@ -279,64 +300,129 @@ void add_trajectory(Output& out, const ExperimentResult& r, const TruthData& tru
   std::string tr = "t_s,east_m,north_m\n";
   double last = -std::numeric_limits<double>::infinity();
   std::size_t n_truth = 0;
-  double e_lo = std::numeric_limits<double>::infinity(), e_hi = -e_lo, n_lo = e_lo, n_hi = -e_lo;
-  auto extend = [&](const Vec3& p) {
-    e_lo = std::min(e_lo, p.y());
-    e_hi = std::max(e_hi, p.y());
-    n_lo = std::min(n_lo, p.x());
-    n_hi = std::max(n_hi, p.x());
-  };
   for (std::size_t i = 0; i < truth.records.size(); ++i) {
     const TruthRecord& rec = truth.records[i];
     if (rec.t < t_lo - 1.0 || rec.t > t_hi + 1.0) continue;
     if (rec.t - last < 0.2 && i + 1 < truth.records.size()) continue;  // 5 Hz is plenty
     last = rec.t;
-    const Vec3 p = frame.ned_from_geodetic(rec.lla);
-    extend(p);
+    const Vec3 p = plot.point(rec.lla);
     tr += num(rec.t) + "," + num(p.y(), 9) + "," + num(p.x(), 9) + "\n";
     ++n_truth;
   }
-  std::vector<std::string> parts;
-  if (n_truth > 0) {
-    out.files.emplace_back("data/truth.csv", std::move(tr));
-    parts.push_back("  \"data/truth.csv\" skip 1 using 2:3 with lines lw 5 lc rgb \"#b0b0b0\" title \"Truth\"");
-    parts.push_back("  \"data/truth.csv\" skip 1 every ::0::0 using 2:3 with points pt 7 ps 2 "
-                    "lc rgb \"#000000\" title \"Start\"");
-  } else {
+  if (n_truth == 0) return false;
+  out.files.emplace_back("data/truth.csv", std::move(tr));
+  plot.parts.push_back("  \"data/truth.csv\" skip 1 using 2:3 with lines lw 5 lc rgb \"#b0b0b0\" title \"Truth\"");
+  plot.parts.push_back("  \"data/truth.csv\" skip 1 every ::0::0 using 2:3 with points pt 7 ps 2 "
+                       "lc rgb \"#000000\" title \"Start\"");
+  return true;
+}
+
+/// data/track_ID.csv, the `i`-th track drawn.
+void add_track(Output& out, TrackPlot& plot, const ExperimentRun& run, std::size_t i) {
+  const std::string rel = "data/track_" + run_id(run) + ".csv";
+  std::string t = "t_s,east_m,north_m\n";
+  for (const auto& rec : run.track) {
+    const Vec3 p = plot.point(rec.lla);
+    t += num(rec.t) + "," + num(p.y(), 9) + "," + num(p.x(), 9) + "\n";
+  }
+  out.files.emplace_back(rel, std::move(t));
+  const std::size_t color = run.configuration == "dual-wheel"   ? 0
+                            : run.configuration == "body-wheel" ? 1
+                            : run.configuration == "triple"     ? 2
+                                                                : 3;
+  // None may hide another where the tracks lie on top of each other: the first drawn is the
+  // widest, each later one narrower, dashed differently and a little transparent (ARGB).
+  const double lw = std::max(1.2, 4.2 - 0.9 * static_cast<double>(i));
+  const char* dash[] = {"1", "(12,5)", "(4,4)", "(14,4,3,4)"};
+  plot.parts.push_back("  " + gq(rel) + " skip 1 using 2:3 with lines lw " + num(lw) + " dt " + dash[color] +
+                       " lc rgb " + gq("#30" + std::string(kTrackColors[color] + 1)) + " title " +
+                       gq(run_title(run)));
+}
+
+/// Truth path and the figure runs' tracks.
+void add_trajectory(Output& out, const ExperimentResult& r, const TruthData& truth,
+                    const earth::LocalFrame& frame) {
+  const std::string name = "trajectory";
+  const std::vector<const ExperimentRun*> runs = track_runs(r);
+  if (runs.empty()) {
+    out.notes.push_back(name + ".png not drawn: no run with a kept track in this experiment");
+    return;
+  }
+  TrackPlot plot(frame);
+  if (!add_truth_path(out, plot, truth, runs))
     out.notes.push_back(name + ".png: the truth does not cover the runs' time span (drawn without it)");
-  }
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const ExperimentRun& run = *runs[i];
-    const std::string rel = "data/track_" + run_id(run) + ".csv";
-    std::string t = "t_s,east_m,north_m\n";
-    for (const auto& rec : run.track) {
-      const Vec3 p = frame.ned_from_geodetic(rec.lla);
-      extend(p);
-      t += num(rec.t) + "," + num(p.y(), 9) + "," + num(p.x(), 9) + "\n";
-    }
-    out.files.emplace_back(rel, std::move(t));
-    const std::size_t color = run.configuration == "dual-wheel"   ? 0
-                              : run.configuration == "body-wheel" ? 1
-                              : run.configuration == "triple"     ? 2
-                                                                  : 3;
-    // None may hide another where the tracks lie on top of each other: the first drawn is the
-    // widest, each later one narrower, dashed differently and a little transparent (ARGB).
-    const double lw = std::max(1.2, 4.2 - 0.9 * static_cast<double>(i));
-    const char* dash[] = {"1", "(12,5)", "(4,4)", "(14,4,3,4)"};
-    parts.push_back("  " + gq(rel) + " skip 1 using 2:3 with lines lw " + num(lw) + " dt " + dash[color] +
-                    " lc rgb " + gq("#30" + std::string(kTrackColors[color] + 1)) + " title " + gq(run_title(run)));
-  }
+  for (std::size_t i = 0; i < runs.size(); ++i) add_track(out, plot, *runs[i], i);
   // Equal scale on a 3:2 canvas: the legend goes where the path leaves room.
-  const bool wide = (e_hi - e_lo) > 1.2 * (n_hi - n_lo);
+  const bool wide = (plot.e_hi - plot.e_lo) > 1.2 * (plot.n_hi - plot.n_lo);
   std::string s = script_head(name, "Truth path and the experiment's figure runs (local east/north).");
   s += "set title " + gq("Trajectory: truth and dead reckoning - " + dataset_text(r)) +
        " font \",15\"\nset size ratio -1\n" +
        (wide ? "set key outside bottom center horizontal Left reverse box samplen 3 spacing 1.2\n"
              : "set key outside right top vertical Left reverse box samplen 3 spacing 1.2\n") +
        "set xlabel \"East [m]\"\nset ylabel \"North [m]\"\nplot \\\n";
+  const auto& parts = plot.parts;
   for (std::size_t i = 0; i < parts.size(); ++i) s += parts[i] + (i + 1 < parts.size() ? ", \\\n" : "\n");
   out.files.emplace_back(name + ".gp", std::move(s));
   out.plots.push_back(name);
+}
+
+/// Fig. 10's curves: each run's drift rate every `step` metres.
+struct DriftCurves {
+  bool fine = false;  ///< from the per-epoch errors (a short drive), for the figure runs only
+  double step = 0.0;
+
+  bool shows(const ExperimentRun& run) const { return !run.centralized && (!fine || run.figure); }
+  std::vector<double> of(const ExperimentRun& run) const {
+    if (!fine) return run.eval.drift_curve;
+    std::vector<double> dist, err;
+    for (const auto& e : run.eval.series) dist.push_back(e.distance), err.push_back(e.err_h);
+    return drift_rate_curve(dist, err, step);
+  }
+};
+
+/// data/drift_CONFIG.csv: one column per run, `kplot` rows.
+std::string drift_data(const std::vector<const ExperimentRun*>& runs, const DriftCurves& curves,
+                       std::size_t kplot) {
+  std::string d = "distance_m";
+  for (const auto* run : runs) d += "," + run_id(*run) + "_pct";
+  d += "\n";
+  std::vector<std::vector<double>> values;
+  for (const auto* run : runs) values.push_back(curves.of(*run));
+  for (std::size_t k = 0; k < kplot; ++k) {
+    d += num(static_cast<double>(k + 1) * curves.step);
+    for (const auto& c : values) d += "," + (k < c.size() ? num(100.0 * c[k], 6) : "");
+    d += "\n";
+  }
+  return d;
+}
+
+/// Fig. 10's panel `p` (a configuration): its data file added to `out`, its script returned.
+std::string drift_panel(Output& out, const ExperimentResult& r, const DriftCurves& curves, std::size_t kplot,
+                        int p) {
+  const std::string key = "set key top right font \",10\" maxrows 8 opaque box\n";
+  const char letters[] = {'a', 'b', 'c', 'd'};
+  const std::string config = kConfigs[p];
+  std::vector<const ExperimentRun*> runs;
+  for (const auto& run : r.runs)
+    if (run.configuration == config && curves.shows(run) && !curves.of(run).empty()) runs.push_back(&run);
+  std::string s = "set title " + gq("(" + std::string(1, letters[p]) + ") " + config_title(config)) + "\n";
+  if (runs.empty())
+    return s + "unset key\nset label 1 \"no run in this experiment\" at graph 0.5,0.5 center\n"
+               "plot [][0:1] NaN notitle\nunset label 1\n";
+  const std::string rel = "data/drift_" + config + ".csv";
+  out.files.emplace_back(rel, drift_data(runs, curves, kplot));
+  s += key + "plot \\\n";
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const ExperimentRun& run = *runs[i];
+    const std::string label =
+        config == "single" ? run.side + " " + (chips_of(run).empty() ? run.label : chips_of(run)[0])
+                           : run.label;
+    s += "  " + gq(rel) + " skip 1 using 1:" + std::to_string(i + 2) + " with linespoints lw 1.5 pt " +
+         std::to_string(5 + static_cast<int>(i % 4)) + " ps 0.8 dt " + (i < 8 ? "1" : "2") +
+         " lc rgb " + gq(kCurveColors[i % 8]) + " title " + gq(label) +
+         (i + 1 < runs.size() ? ", \\\n" : "\n");
+  }
+  return s;
 }
 
 /// Fig. 10: drift rate against distance, one panel per configuration.
@@ -356,70 +442,28 @@ void add_drift_figure(Output& out, const ExperimentResult& r) {
   }
   // A short drive (fewer than 5 segments) would leave each curve one or two points: the
   // curve is then drawn every l/10 from the per-epoch errors, which the figure runs keep.
-  const bool fine = kmax < 5;
-  const double step = fine ? segment / 10.0 : segment;
-  auto curve_of = [&](const ExperimentRun& run) {
-    if (!fine) return run.eval.drift_curve;
-    std::vector<double> dist, err;
-    for (const auto& e : run.eval.series) dist.push_back(e.distance), err.push_back(e.err_h);
-    return drift_rate_curve(dist, err, step);
-  };
+  DriftCurves curves;
+  curves.fine = kmax < 5;
+  curves.step = curves.fine ? segment / 10.0 : segment;
   std::size_t kplot = 0;
   for (const auto& run : r.runs)
-    if (!run.centralized && (!fine || run.figure)) kplot = std::max(kplot, curve_of(run).size());
+    if (curves.shows(run)) kplot = std::max(kplot, curves.of(run).size());
   if (kplot == 0) {
-    out.notes.push_back(name + ".png not drawn: the drive is shorter than " + num(step) + " m");
+    out.notes.push_back(name + ".png not drawn: the drive is shorter than " + num(curves.step) + " m");
     return;
   }
-  if (fine)
+  if (curves.fine)
     out.notes.push_back(name + ".png: the drive covers " + std::to_string(kmax) + " segment(s) of " + num(segment) +
-                        " m only, so the curves are drawn every " + num(step) + " m, for the figure runs");
+                        " m only, so the curves are drawn every " + num(curves.step) + " m, for the figure runs");
   std::string s = script_head(name, "Fig. 10 of the paper: drift rate r_k = max horizontal error within "
                                     "k*l / (k*l) against the distance k*l, every run.");
   s += "set multiplot layout 2,2 title " +
-       gq(fine ? "Fig. 10: position drift rate against distance, every " + num(step) +
-                     " m (a short drive: the figure runs) - " + dataset_text(r)
-               : "Fig. 10: position drift rate against distance, every run - " + dataset_text(r)) +
+       gq(curves.fine ? "Fig. 10: position drift rate against distance, every " + num(curves.step) +
+                            " m (a short drive: the figure runs) - " + dataset_text(r)
+                      : "Fig. 10: position drift rate against distance, every run - " + dataset_text(r)) +
        " font \",15\"\nset xlabel \"Distance [m]\"\nset ylabel \"Drift rate [%]\"\n"
-       "set xrange [0:" + num(static_cast<double>(kplot + 1) * step) + "]\nset yrange [0:*]\n";
-  const std::string key = "set key top right font \",10\" maxrows 8 opaque box\n";
-  const char letters[] = {'a', 'b', 'c', 'd'};
-  for (int p = 0; p < 4; ++p) {
-    const std::string config = kConfigs[p];
-    std::vector<const ExperimentRun*> runs;
-    for (const auto& run : r.runs)
-      if (run.configuration == config && !run.centralized && (!fine || run.figure) && !curve_of(run).empty())
-        runs.push_back(&run);
-    s += "set title " + gq("(" + std::string(1, letters[p]) + ") " + config_title(config)) + "\n";
-    if (runs.empty()) {
-      s += "unset key\nset label 1 \"no run in this experiment\" at graph 0.5,0.5 center\n"
-           "plot [][0:1] NaN notitle\nunset label 1\n";
-      continue;
-    }
-    const std::string rel = "data/drift_" + config + ".csv";
-    std::string d = "distance_m";
-    for (const auto* run : runs) d += "," + run_id(*run) + "_pct";
-    d += "\n";
-    std::vector<std::vector<double>> curves;
-    for (const auto* run : runs) curves.push_back(curve_of(*run));
-    for (std::size_t k = 0; k < kplot; ++k) {
-      d += num(static_cast<double>(k + 1) * step);
-      for (const auto& c : curves) d += "," + (k < c.size() ? num(100.0 * c[k], 6) : "");
-      d += "\n";
-    }
-    out.files.emplace_back(rel, std::move(d));
-    s += key + "plot \\\n";
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-      const ExperimentRun& run = *runs[i];
-      const std::string label =
-          config == "single" ? run.side + " " + (chips_of(run).empty() ? run.label : chips_of(run)[0])
-                             : run.label;
-      s += "  " + gq(rel) + " skip 1 using 1:" + std::to_string(i + 2) + " with linespoints lw 1.5 pt " +
-           std::to_string(5 + static_cast<int>(i % 4)) + " ps 0.8 dt " + (i < 8 ? "1" : "2") +
-           " lc rgb " + gq(kCurveColors[i % 8]) + " title " + gq(label) +
-           (i + 1 < runs.size() ? ", \\\n" : "\n");
-    }
-  }
+       "set xrange [0:" + num(static_cast<double>(kplot + 1) * curves.step) + "]\nset yrange [0:*]\n";
+  for (int p = 0; p < 4; ++p) s += drift_panel(out, r, curves, kplot, p);
   s += "unset multiplot\n";
   out.files.emplace_back(name + ".gp", std::move(s));
   out.plots.push_back(name);

@@ -66,6 +66,20 @@ Fit2 ls2(const std::vector<double>& v, const std::vector<double>& x, const std::
 }
 
 
+/// `floor`, or the standard deviation of the mean of three or more estimates from parts of
+/// the drive where that is larger.
+double sigma_of_parts(const std::vector<double>& parts, double floor) {
+  double sd = floor;
+  if (parts.size() >= 3) {
+    double mean = 0.0, ss = 0.0;
+    for (double a : parts) mean += a;
+    mean /= static_cast<double>(parts.size());
+    for (double a : parts) ss += (a - mean) * (a - mean);
+    sd = std::max(sd, std::sqrt(ss / static_cast<double>(parts.size() - 1) / static_cast<double>(parts.size())));
+  }
+  return sd;
+}
+
 using survey::Signal;
 using eval::Vec2;
 
@@ -120,17 +134,9 @@ SpeedScale fit_speed_scale(const RefSpeed& ref_speed, const Signal& x_sig, const
     const Fit2 fp = ls2(v, x, y, kp);
     if (fp.n >= 40 && fp.a > 0.0) parts.push_back(fp.a);
   }
-  double sd = f.sigma_a;
-  if (parts.size() >= 3) {
-    double mean = 0.0, ss = 0.0;
-    for (double a : parts) mean += a;
-    mean /= static_cast<double>(parts.size());
-    for (double a : parts) ss += (a - mean) * (a - mean);
-    sd = std::max(sd, std::sqrt(ss / static_cast<double>(parts.size() - 1) / static_cast<double>(parts.size())));
-  }
   out.observed = true;
   out.scale = f.a;
-  out.sigma = sd;
+  out.sigma = sigma_of_parts(parts, f.sigma_a);
   return out;
 }
 
@@ -220,25 +226,59 @@ AntennaFit fit_antenna(const eval::PlanarTrack& ref, const eval::PlanarTrack& tr
   return out;
 }
 
-}  // namespace
+/// The reference track on the manifest's local frame, with its speed at its records.
+struct ReferenceTrack {
+  eval::PlanarTrack track;
+  std::vector<double> v;  ///< [m/s] at the records (central differences)
+  /// [m/s] at t: linear between the records, NaN outside them.
+  double speed(double t) const {
+    const auto it = std::lower_bound(track.t.begin(), track.t.end(), t);
+    if (it == track.t.begin() || it == track.t.end()) return std::nan("");
+    const std::size_t k = static_cast<std::size_t>(it - track.t.begin());
+    const double a = (t - track.t[k - 1]) / (track.t[k] - track.t[k - 1]);
+    return (1.0 - a) * v[k - 1] + a * v[k];
+  }
+};
 
-ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::vector<std::string>& modules,
-                                                 const InstallationCalibration& installation,
-                                                 const ReferenceCalibrationOptions& o, const WarningSink& warn) {
-  ReferenceCalibration out;
-  const Manifest m = installation.empty() ? m0 : apply_calibration(m0, installation);
+/// The manifest's truth on its local frame, on the manifest's clock; InputError without one or
+/// for one too short.
+ReferenceTrack read_reference(const Manifest& m) {
   if (!m.truth_file)
     throw InputError(quote(m.path) + ": names no truth: calibrating against a reference needs one (truth: FILE)");
   const TruthData truth = read_truth(m.resolve(*m.truth_file));
   const earth::LocalFrame frame(m.origin);
-  eval::PlanarTrack ref;
+  ReferenceTrack out;
+  eval::PlanarTrack& ref = out.track;
   for (const TruthRecord& r : truth.records) {
     ref.t.push_back(r.t + m.truth_time_offset);
     ref.p_ne.push_back(frame.ned_from_geodetic(r.lla).head<2>());
   }
   if (ref.t.size() < 10) throw InputError(quote(truth.file) + ": fewer than 10 records: too short a reference");
+  // The reference's speed at its records (central differences).
+  out.v.assign(ref.t.size(), 0.0);
+  for (std::size_t k = 1; k + 1 < ref.t.size(); ++k) {
+    const double dt = ref.t[k + 1] - ref.t[k - 1];
+    if (dt > 0.0) out.v[k] = (ref.p_ne[k + 1] - ref.p_ne[k - 1]).norm() / dt;
+  }
+  return out;
+}
 
-  // The modules' series (manifest clocks) and what the data say of them.
+/// What the calibration works from: the manifest as given and with the installation applied,
+/// the reference, the modules' series (manifest clocks) and what the data say of them, each
+/// module's gyro bias and the vehicle's yaw rate.
+struct Drive {
+  const Manifest& m0;
+  const Manifest& m;
+  const std::vector<std::string>& modules;
+  const ReferenceCalibrationOptions& o;
+  ReferenceTrack ref;
+  std::vector<survey::Series> S;
+  survey::DatasetSurvey sv;
+  std::vector<Vec3> bias;
+  Signal yaw;
+};
+
+std::vector<survey::Series> read_module_series(const Manifest& m, const std::vector<std::string>& modules) {
   std::vector<survey::Series> S;
   for (const auto& name : modules) {
     const ModuleSpec* spec = m.find(name);
@@ -247,237 +287,311 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     ro.pass_nonfinite = true;
     S.push_back(survey::read_series(name, m.resolve(spec->file), ro));
   }
-  const survey::DatasetSurvey sv = survey::survey_series(S);
-  // Each module's gyro bias over the manifest's static period (the survey's where it has no data).
+  return S;
+}
+
+std::vector<Vec3> static_gyro_bias(const Drive& drive) {
+  const Manifest& m = drive.m;
+  const std::vector<survey::Series>& S = drive.S;
   std::vector<Vec3> bias(S.size());
   for (std::size_t i = 0; i < S.size(); ++i) {
     Vec3 sum = Vec3::Zero();
     double n = 0.0;
     for (std::size_t k = S[i].index(m.static_start); k < S[i].size() && S[i].time(k) <= m.static_end; ++k)
       if (S[i].time(k) >= m.static_start) sum += S[i].gyro[k], n += 1.0;
-    bias[i] = n >= 50.0 ? Vec3(sum / n) : sv.modules[i].traits.gyro_bias;
+    bias[i] = n >= 50.0 ? Vec3(sum / n) : drive.sv.modules[i].traits.gyro_bias;
   }
+  return bias;
+}
 
-  // The vehicle's yaw rate (up positive): a Body-IMU's, else the unsteered wheels' mean.
-  std::vector<Sampled> yaw_sources;
-  for (std::size_t i = 0; i < modules.size(); ++i) {
-    const ModuleSpec& spec = *m.find(modules[i]);
+/// The sources of the vehicle's yaw rate (up positive): a Body-IMU, else the unsteered wheels.
+std::vector<Sampled> yaw_sources(const Drive& drive) {
+  const std::vector<survey::Series>& S = drive.S;
+  const survey::DatasetSurvey& sv = drive.sv;
+  std::vector<Sampled> sources;
+  for (std::size_t i = 0; i < drive.modules.size(); ++i) {
+    const ModuleSpec& spec = *drive.m.find(drive.modules[i]);
     if (spec.kind != ModuleKind::kBody) continue;
     const Mat3 C = dcm_from_euler(spec.mounting_rpy);
     Sampled y{&S[i], std::vector<double>(S[i].size())};
-    for (std::size_t k = 0; k < S[i].size(); ++k) y.x[k] = -(C * (S[i].gyro[k] - bias[i])).z();
-    yaw_sources.push_back(std::move(y));
+    for (std::size_t k = 0; k < S[i].size(); ++k) y.x[k] = -(C * (S[i].gyro[k] - drive.bias[i])).z();
+    sources.push_back(std::move(y));
     break;
   }
-  if (yaw_sources.empty())
-    for (std::size_t i = 0; i < modules.size(); ++i)
+  if (sources.empty())
+    for (std::size_t i = 0; i < drive.modules.size(); ++i)
       if (sv.modules[i].kind == ModuleKind::kWheel && !sv.modules[i].steered)
-        yaw_sources.push_back({&S[i], survey::yaw_rate(S[i], sv.modules[i].traits)});
+        sources.push_back({&S[i], survey::yaw_rate(S[i], sv.modules[i].traits)});
+  return sources;
+}
 
-  // The yaw rate as one signal on the first source's bins (the mean of the sources).
+/// The yaw rate as one signal on the first source's bins (the mean of the sources).
+Signal mean_yaw_rate(const std::vector<Sampled>& sources) {
   Signal yaw;
-  if (!yaw_sources.empty()) {
-    const survey::Series& base = *yaw_sources.front().s;
+  if (!sources.empty()) {
+    const survey::Series& base = *sources.front().s;
     for (std::size_t k = 0; k < base.size(); ++k) {
       double y = 0.0;
-      for (const Sampled& src : yaw_sources) y += src.at(base.time(k));
+      for (const Sampled& src : sources) y += src.at(base.time(k));
       yaw.t.push_back(base.time(k));
-      yaw.x.push_back(y / static_cast<double>(yaw_sources.size()));
+      yaw.x.push_back(y / static_cast<double>(sources.size()));
     }
     yaw.step = base.dt;
   }
+  return yaw;
+}
 
-  // The reference's speed at its records (central differences).
-  std::vector<double> ref_v(ref.t.size(), 0.0);
-  for (std::size_t k = 1; k + 1 < ref.t.size(); ++k) {
-    const double dt = ref.t[k + 1] - ref.t[k - 1];
-    if (dt > 0.0) ref_v[k] = (ref.p_ne[k + 1] - ref.p_ne[k - 1]).norm() / dt;
+/// Module i is an unsteered wheel, by both the survey and the manifest.
+bool unsteered_wheel(const Drive& drive, std::size_t i) {
+  const survey::DatasetSurvey& sv = drive.sv;
+  return sv.modules[i].kind == ModuleKind::kWheel && !sv.modules[i].steered &&
+         drive.m.find(drive.modules[i])->kind == ModuleKind::kWheel;
+}
+
+/// A wheel's speed in turns of its axle (rad/s, forward positive), from the raw rate.
+Signal axle_rate(const Drive& drive, std::size_t i) {
+  const std::vector<survey::Series>& S = drive.S;
+  const ModuleSpec& spec = *drive.m.find(drive.modules[i]);
+  const Mat3 C = wheel_sensor_to_body(spec);
+  Signal omega;
+  for (std::size_t k = 0; k < S[i].size(); ++k) {
+    omega.t.push_back(S[i].time(k));
+    omega.x.push_back(-spec.axle_sign * (C * (S[i].gyro[k] - drive.bias[i])).x());
   }
-  auto ref_speed = [&](double t) {
-    const auto it = std::lower_bound(ref.t.begin(), ref.t.end(), t);
-    if (it == ref.t.begin() || it == ref.t.end()) return std::nan("");
-    const std::size_t k = static_cast<std::size_t>(it - ref.t.begin());
-    const double a = (t - ref.t[k - 1]) / (ref.t[k] - ref.t[k - 1]);
-    return (1.0 - a) * ref_v[k - 1] + a * ref_v[k];
-  };
+  omega.step = S[i].dt;
+  return omega;
+}
 
-  // A wheel's speed in turns of its axle (rad/s, forward positive), from the raw rate.
-  auto axle_rate = [&](std::size_t i) {
-    const ModuleSpec& spec = *m.find(modules[i]);
-    const Mat3 C = wheel_sensor_to_body(spec);
-    Signal omega;
-    for (std::size_t k = 0; k < S[i].size(); ++k) {
-      omega.t.push_back(S[i].time(k));
-      omega.x.push_back(-spec.axle_sign * (C * (S[i].gyro[k] - bias[i])).x());
-    }
-    omega.step = S[i].dt;
-    return omega;
-  };
+/// The shift of the reference's times within +-0.25 s that best fits its speed to the wheel's
+/// turn rate `omega` between `from` and `to` (refined by a parabola); NaN: none.
+double best_shift(const Drive& drive, const Signal& omega, double from, double to) {
+  const double step = 0.01;
+  std::vector<double> corr;
+  for (int k = -25; k <= 25; ++k) {
+    const double d = k * step;
+    const auto shifted = [&](double t) { return drive.ref.speed(t - d); };
+    Signal part = omega;
+    std::vector<double> keep_t, keep_x;
+    for (std::size_t q = 0; q < omega.t.size(); ++q)
+      if (omega.t[q] >= from && omega.t[q] <= to) keep_t.push_back(omega.t[q]), keep_x.push_back(omega.x[q]);
+    part.t = keep_t;
+    part.x = keep_x;
+    const SpeedScale f = fit_speed_scale(shifted, part, drive.yaw, drive.m.static_end, drive.o.min_speed);
+    corr.push_back(f.observed ? f.correlation : -1.0);
+  }
+  std::size_t b = 0;
+  for (std::size_t k = 1; k < corr.size(); ++k)
+    if (corr[k] > corr[b]) b = k;
+  if (corr[b] < 0.0 || b == 0 || b + 1 == corr.size()) return std::nan("");
+  const double den = corr[b - 1] - 2.0 * corr[b] + corr[b + 1];
+  const double frac = den < 0.0 ? std::clamp(0.5 * (corr[b - 1] - corr[b + 1]) / den, -0.5, 0.5) : 0.0;
+  return (static_cast<double>(b) - 25.0 + frac) * step;
+}
 
-  // The reference's clock, refined: the shift of its times that best fits its speed to an
-  // unsteered wheel's with the yaw term (its antenna's speed departs from the wheels' in
-  // turns, which pulls a plain correlation of the speeds, as the import's); scanned over
-  // +-0.25 s, refined by a parabola; 1 sigma from five parts of the drive.
-  out.truth_time_offset = CalibratedValue{m.truth_time_offset, 0.0, false};
-  for (std::size_t i = 0; i < modules.size(); ++i) {
-    if (sv.modules[i].kind != ModuleKind::kWheel || sv.modules[i].steered || m.find(modules[i])->kind != ModuleKind::kWheel)
-      continue;
-    const Signal omega = axle_rate(i);
-    auto best_shift = [&](double from, double to) {
-      const double step = 0.01;
-      std::vector<double> corr;
-      for (int k = -25; k <= 25; ++k) {
-        const double d = k * step;
-        const auto shifted = [&](double t) { return ref_speed(t - d); };
-        Signal part = omega;
-        std::vector<double> keep_t, keep_x;
-        for (std::size_t q = 0; q < omega.t.size(); ++q)
-          if (omega.t[q] >= from && omega.t[q] <= to) keep_t.push_back(omega.t[q]), keep_x.push_back(omega.x[q]);
-        part.t = keep_t;
-        part.x = keep_x;
-        const SpeedScale f = fit_speed_scale(shifted, part, yaw, m.static_end, o.min_speed);
-        corr.push_back(f.observed ? f.correlation : -1.0);
-      }
-      std::size_t b = 0;
-      for (std::size_t k = 1; k < corr.size(); ++k)
-        if (corr[k] > corr[b]) b = k;
-      if (corr[b] < 0.0 || b == 0 || b + 1 == corr.size()) return std::nan("");
-      const double den = corr[b - 1] - 2.0 * corr[b] + corr[b + 1];
-      const double frac = den < 0.0 ? std::clamp(0.5 * (corr[b - 1] - corr[b + 1]) / den, -0.5, 0.5) : 0.0;
-      return (static_cast<double>(b) - 25.0 + frac) * step;
-    };
-    const double d = best_shift(-1e300, 1e300);
+/// The reference's clock, refined: the shift of its times that best fits its speed to an
+/// unsteered wheel's with the yaw term (its antenna's speed departs from the wheels' in
+/// turns, which pulls a plain correlation of the speeds, as the import's); scanned over
+/// +-0.25 s, refined by a parabola; 1 sigma from five parts of the drive. The reference's
+/// times are moved onto the refined clock.
+CalibratedValue refine_clock(Drive& drive) {
+  const Manifest& m = drive.m;
+  for (std::size_t i = 0; i < drive.modules.size(); ++i) {
+    if (!unsteered_wheel(drive, i)) continue;
+    const Signal omega = axle_rate(drive, i);
+    const double d = best_shift(drive, omega, -1e300, 1e300);
     if (!std::isfinite(d)) break;
     std::vector<double> parts;
     const double t0 = std::max(m.static_end, omega.start()), len = (omega.end() - t0) / 5.0;
     for (int p = 0; p < 5; ++p) {
-      const double dp = best_shift(t0 + p * len, t0 + (p + 1) * len);
+      const double dp = best_shift(drive, omega, t0 + p * len, t0 + (p + 1) * len);
       if (std::isfinite(dp)) parts.push_back(dp);
     }
-    double sd = 0.005;
-    if (parts.size() >= 3) {
-      double mean = 0.0, ss = 0.0;
-      for (double x : parts) mean += x;
-      mean /= static_cast<double>(parts.size());
-      for (double x : parts) ss += (x - mean) * (x - mean);
-      sd = std::max(sd, std::sqrt(ss / static_cast<double>(parts.size() - 1) / static_cast<double>(parts.size())));
-    }
-    out.truth_time_offset = CalibratedValue{m.truth_time_offset + d, sd, true};
-    for (double& t : ref.t) t += d;  // everything below on the refined clock
-    break;
+    const double sd = sigma_of_parts(parts, 0.005);
+    for (double& t : drive.ref.track.t) t += d;  // everything below on the refined clock
+    return CalibratedValue{m.truth_time_offset + d, sd, true};
   }
+  return CalibratedValue{m.truth_time_offset, 0.0, false};
+}
 
-  // Each wheel's radius: first from its turn rate, then from the speed its own Wheel-INS
-  // gives with that radius (the filter refines the axle gyro's scale factor against gravity,
-  // so the radius that makes the filter's speed right is what the run needs).
-  for (std::size_t i = 0; i < modules.size(); ++i) {
-    const ModuleSpec& spec = *m.find(modules[i]);
-    if (spec.kind != ModuleKind::kWheel) continue;
-    WheelRadiusFit w;
-    w.module = spec.name;
-    w.manifest_radius = m0.find(spec.name)->wheel_radius;
-    w.radius = CalibratedValue{spec.wheel_radius, 0.0, false};
-    const Signal omega = axle_rate(i);
-    const SpeedScale first = fit_speed_scale(ref_speed, omega, yaw, m.static_end, o.min_speed);
-    w.epochs = first.epochs;
-    w.correlation = first.correlation;
-    if (!first.observed) {
-      out.notes.push_back(spec.name + fmt(": %.0f epochs faster than %.1f m/s against the reference: the radius is not observed",
-                                          static_cast<double>(first.epochs), o.min_speed));
-      out.wheels.push_back(w);
-      continue;
-    }
-    w.radius = CalibratedValue{first.scale, first.sigma, true};
-    w.odometry_radius = w.radius;
-    // The second pass: the filter's speed with the first radius.
-    Manifest one = m;
-    for (auto& x : one.modules)
-      if (x.name == spec.name) x.wheel_radius = first.scale;
-    one.heading_known = false;
-    const Signal filter_speed = wheel_ins_speed(one, spec.name);
-    const SpeedScale second = fit_speed_scale(ref_speed, filter_speed, yaw, m.static_end, o.min_speed);
-    if (second.observed) {
-      w.radius = CalibratedValue{first.scale * second.scale, first.scale * second.sigma, true};
-      w.correlation = second.correlation;
-      w.epochs = second.epochs;
-    }
-    if (!(w.radius.std < 0.05 * w.radius.value)) w.radius = CalibratedValue{spec.wheel_radius, w.radius.std, false};
-    out.wheels.push_back(w);
+/// The speed the filter gives with the radius of the wheel `spec` set to `radius`.
+Signal filter_speed(const Manifest& m, const ModuleSpec& spec, double radius) {
+  Manifest one = m;
+  for (auto& x : one.modules)
+    if (x.name == spec.name) x.wheel_radius = radius;
+  one.heading_known = false;
+  return wheel_ins_speed(one, spec.name);
+}
+
+/// The radius of wheel i: first from its turn rate, then from the speed its own Wheel-INS
+/// gives with that radius; a note for one not observed goes to `notes`.
+WheelRadiusFit fit_wheel_radius(const Drive& drive, std::size_t i, std::vector<std::string>& notes) {
+  const Manifest& m = drive.m;
+  const ReferenceCalibrationOptions& o = drive.o;
+  const auto ref_speed = [&drive](double t) { return drive.ref.speed(t); };
+  const ModuleSpec& spec = *m.find(drive.modules[i]);
+  WheelRadiusFit w;
+  w.module = spec.name;
+  w.manifest_radius = drive.m0.find(spec.name)->wheel_radius;
+  w.radius = CalibratedValue{spec.wheel_radius, 0.0, false};
+  const Signal omega = axle_rate(drive, i);
+  const SpeedScale first = fit_speed_scale(ref_speed, omega, drive.yaw, m.static_end, o.min_speed);
+  w.epochs = first.epochs;
+  w.correlation = first.correlation;
+  if (!first.observed) {
+    notes.push_back(spec.name + fmt(": %.0f epochs faster than %.1f m/s against the reference: the radius is not observed",
+                                    static_cast<double>(first.epochs), o.min_speed));
+    return w;
   }
+  w.radius = CalibratedValue{first.scale, first.sigma, true};
+  w.odometry_radius = w.radius;
+  // The second pass: the filter's speed with the first radius.
+  const SpeedScale second =
+      fit_speed_scale(ref_speed, filter_speed(m, spec, first.scale), drive.yaw, m.static_end, o.min_speed);
+  if (second.observed) {
+    w.radius = CalibratedValue{first.scale * second.scale, first.scale * second.sigma, true};
+    w.correlation = second.correlation;
+    w.epochs = second.epochs;
+  }
+  if (!(w.radius.std < 0.05 * w.radius.value)) w.radius = CalibratedValue{spec.wheel_radius, w.radius.std, false};
+  return w;
+}
 
-  // A dead reckoning with the radii in a local frame, aligned onto the reference.
+/// The manifest of the dead reckoning: the radii observed, in a local frame (heading 0).
+Manifest dead_reckoning_manifest(const Manifest& m, const std::vector<WheelRadiusFit>& wheels) {
   Manifest dr = m;
-  for (const WheelRadiusFit& w : out.wheels)
+  for (const WheelRadiusFit& w : wheels)
     if (w.radius.observed)
       for (auto& s : dr.modules)
         if (s.name == w.module) s.wheel_radius = w.radius.value;
   dr.heading_known = false;
   dr.initial_heading = 0.0;
-  for (std::size_t i = 0; i < modules.size(); ++i)
-    if (sv.modules[i].kind == ModuleKind::kWheel && !sv.modules[i].steered && m.find(modules[i])->kind == ModuleKind::kWheel)
-      out.navigation_modules.push_back(modules[i]);
-  if (out.navigation_modules.empty())
-    for (const auto& name : modules)
-      if (m.find(name)->kind == ModuleKind::kWheel) out.navigation_modules.push_back(name);
+  return dr;
+}
+
+/// The modules to dead-reckon with: the unsteered wheels, else every wheel.
+std::vector<std::string> navigation_modules(const Drive& drive) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < drive.modules.size(); ++i)
+    if (unsteered_wheel(drive, i)) out.push_back(drive.modules[i]);
+  if (out.empty())
+    for (const auto& name : drive.modules)
+      if (drive.m.find(name)->kind == ModuleKind::kWheel) out.push_back(name);
+  return out;
+}
+
+/// The track of a dead reckoning of `modules` with the manifest `dr`.
+eval::PlanarTrack dead_reckon(const Manifest& dr, const std::vector<std::string>& modules, bool progress) {
+  RunRequest req;
+  req.manifest = dr;
+  req.modules = modules;
+  req.calibration = CalibrationMode::kManifest;
+  req.data_checks = false;
+  req.progress = progress;
+  req.warn = [&](const std::string&) {};  // the run's own warnings belong to the run, not here
+  eval::PlanarTrack traj;
+  req.on_record = [&](const TrajectoryRecord& r) {
+    traj.t.push_back(r.t);
+    traj.p_ne.push_back(r.p_inN.head<2>());
+    traj.heading.push_back(r.rpy.z());
+  };
+  run_navigation(req);
+  return traj;
+}
+
+eval::StartAlignmentOptions alignment_options(const ReferenceCalibrationOptions& o) {
+  eval::StartAlignmentOptions ao;
+  ao.length = o.align_length;
+  ao.estimate_antenna = false;
+  return ao;
+}
+
+/// The antenna of the alignment `a` (found) taken where the drive determines it, and the start
+/// fitted again with it; a note where it is not determined.
+void take_antenna(const Drive& drive, const eval::PlanarTrack& traj, const eval::StartAlignment& a,
+                  ReferenceCalibration& out) {
+  const Manifest& m = drive.m;
+  // Observed only where the drive's turns determine it, and on the vehicle: a drive
+  // without turns trades the antenna for the start (the fit then lands metres off).
+  const double reach_x = std::max(2.0, m.wheelbase + 1.5), reach_y = std::max(1.0, 0.5 * m.track_width + 0.5);
+  const bool on_vehicle = std::abs(a.antenna.x()) <= reach_x && std::abs(a.antenna.y()) <= reach_y;
+  const bool sharp = a.antenna_sigma.maxCoeff() < drive.o.max_antenna_sigma;
+  out.antenna_forward = CalibratedValue{a.antenna.x(), a.antenna_sigma.x(), on_vehicle && sharp};
+  out.antenna_right = CalibratedValue{a.antenna.y(), a.antenna_sigma.y(), on_vehicle && sharp};
+  // The start again with the antenna where it is (the heading no longer absorbs it).
+  if (on_vehicle && sharp) {
+    eval::StartAlignmentOptions ao = alignment_options(drive.o);
+    ao.antenna = a.antenna;
+    const eval::StartAlignment again = eval::fit_start_alignment(drive.ref.track, traj, ao);
+    if (again.found) {
+      out.alignment = again;
+      out.alignment.antenna = a.antenna;
+      out.alignment.antenna_sigma = a.antenna_sigma;
+      out.initial_heading = CalibratedValue{again.yaw, again.yaw_sigma, again.yaw_sigma < 5.0 * kDeg};
+    }
+  }
+  if (!on_vehicle || !sharp)
+    out.notes.push_back(fmt("the antenna (forward %.2f +- %.2f m, right %.2f +- %.2f m) is not determined by this drive",
+                            a.antenna.x(), a.antenna_sigma.x(), a.antenna.y(), a.antenna_sigma.y()) +
+                        (on_vehicle ? " (too few turns): the manifest's kept" : " (off the vehicle): the manifest's kept"));
+}
+
+/// The dead reckoning's track `traj` aligned onto the reference: the start, and the antenna.
+void align_onto_reference(const Drive& drive, const eval::PlanarTrack& traj, ReferenceCalibration& out) {
+  const ReferenceCalibrationOptions& o = drive.o;
+  out.alignment = eval::fit_start_alignment(drive.ref.track, traj, alignment_options(o));
+  eval::StartAlignment a = out.alignment;
+  if (a.found && o.estimate_antenna) {
+    const AntennaFit af = fit_antenna(drive.ref.track, traj, a.yaw);
+    a.antenna = af.antenna;
+    a.antenna_sigma = af.sigma;
+    if (!af.found) a.antenna_sigma = Vec2::Constant(std::numeric_limits<double>::infinity());
+  }
+  if (a.found) {
+    out.initial_heading = CalibratedValue{a.yaw, a.yaw_sigma, a.yaw_sigma < 5.0 * kDeg};
+    if (o.estimate_antenna) take_antenna(drive, traj, a, out);
+  } else {
+    out.notes.push_back("the dead reckoning could not be aligned onto the reference (too few common epochs)");
+  }
+}
+
+/// A dead reckoning with the radii in a local frame, aligned onto the reference.
+void align_dead_reckoning(const Drive& drive, ReferenceCalibration& out) {
+  const Manifest& m = drive.m;
+  const Manifest dr = dead_reckoning_manifest(m, out.wheels);
+  out.navigation_modules = navigation_modules(drive);
   out.initial_heading = CalibratedValue{m.initial_heading, 0.0, false};
   out.antenna_forward = CalibratedValue{m.antenna_inV ? m.antenna_inV->x() : 0.0, 0.0, false};
   out.antenna_right = CalibratedValue{m.antenna_inV ? m.antenna_inV->y() : 0.0, 0.0, false};
-  if (!out.navigation_modules.empty()) {
-    RunRequest req;
-    req.manifest = dr;
-    req.modules = out.navigation_modules;
-    req.calibration = CalibrationMode::kManifest;
-    req.data_checks = false;
-    req.progress = o.progress;
-    req.warn = [&](const std::string&) {};  // the run's own warnings belong to the run, not here
-    eval::PlanarTrack traj;
-    req.on_record = [&](const TrajectoryRecord& r) {
-      traj.t.push_back(r.t);
-      traj.p_ne.push_back(r.p_inN.head<2>());
-      traj.heading.push_back(r.rpy.z());
-    };
-    run_navigation(req);
-    eval::StartAlignmentOptions ao;
-    ao.length = o.align_length;
-    ao.estimate_antenna = false;
-    out.alignment = eval::fit_start_alignment(ref, traj, ao);
-    eval::StartAlignment a = out.alignment;
-    if (a.found && o.estimate_antenna) {
-      const AntennaFit af = fit_antenna(ref, traj, a.yaw);
-      a.antenna = af.antenna;
-      a.antenna_sigma = af.sigma;
-      if (!af.found) a.antenna_sigma = Vec2::Constant(std::numeric_limits<double>::infinity());
-    }
-    if (a.found) {
-      out.initial_heading = CalibratedValue{a.yaw, a.yaw_sigma, a.yaw_sigma < 5.0 * kDeg};
-      if (o.estimate_antenna) {
-        // Observed only where the drive's turns determine it, and on the vehicle: a drive
-        // without turns trades the antenna for the start (the fit then lands metres off).
-        const double reach_x = std::max(2.0, m.wheelbase + 1.5), reach_y = std::max(1.0, 0.5 * m.track_width + 0.5);
-        const bool on_vehicle = std::abs(a.antenna.x()) <= reach_x && std::abs(a.antenna.y()) <= reach_y;
-        const bool sharp = a.antenna_sigma.maxCoeff() < o.max_antenna_sigma;
-        out.antenna_forward = CalibratedValue{a.antenna.x(), a.antenna_sigma.x(), on_vehicle && sharp};
-        out.antenna_right = CalibratedValue{a.antenna.y(), a.antenna_sigma.y(), on_vehicle && sharp};
-        // The start again with the antenna where it is (the heading no longer absorbs it).
-        if (on_vehicle && sharp) {
-          ao.antenna = a.antenna;
-          const eval::StartAlignment again = eval::fit_start_alignment(ref, traj, ao);
-          if (again.found) {
-            out.alignment = again;
-            out.alignment.antenna = a.antenna;
-            out.alignment.antenna_sigma = a.antenna_sigma;
-            out.initial_heading = CalibratedValue{again.yaw, again.yaw_sigma, again.yaw_sigma < 5.0 * kDeg};
-          }
-        }
-        if (!on_vehicle || !sharp)
-          out.notes.push_back(fmt("the antenna (forward %.2f +- %.2f m, right %.2f +- %.2f m) is not determined by this drive",
-                                  a.antenna.x(), a.antenna_sigma.x(), a.antenna.y(), a.antenna_sigma.y()) +
-                              (on_vehicle ? " (too few turns): the manifest's kept" : " (off the vehicle): the manifest's kept"));
-      }
-    } else {
-      out.notes.push_back("the dead reckoning could not be aligned onto the reference (too few common epochs)");
-    }
-  }
+  if (!out.navigation_modules.empty())
+    align_onto_reference(drive, dead_reckon(dr, out.navigation_modules, drive.o.progress), out);
+}
+
+}  // namespace
+
+ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::vector<std::string>& modules,
+                                                 const InstallationCalibration& installation,
+                                                 const ReferenceCalibrationOptions& o, const WarningSink& warn) {
+  ReferenceCalibration out;
+  const Manifest m = installation.empty() ? m0 : apply_calibration(m0, installation);
+  Drive drive{m0, m, modules, o, read_reference(m), {}, {}, {}, {}};
+
+  // The modules' series (manifest clocks) and what the data say of them.
+  drive.S = read_module_series(m, modules);
+  drive.sv = survey::survey_series(drive.S);
+  // Each module's gyro bias over the manifest's static period (the survey's where it has no data).
+  drive.bias = static_gyro_bias(drive);
+  // The vehicle's yaw rate (up positive): a Body-IMU's, else the unsteered wheels' mean.
+  drive.yaw = mean_yaw_rate(yaw_sources(drive));
+
+  out.truth_time_offset = refine_clock(drive);
+
+  // Each wheel's radius: first from its turn rate, then from the speed its own Wheel-INS
+  // gives with that radius (the filter refines the axle gyro's scale factor against gravity,
+  // so the radius that makes the filter's speed right is what the run needs).
+  for (std::size_t i = 0; i < modules.size(); ++i)
+    if (m.find(modules[i])->kind == ModuleKind::kWheel) out.wheels.push_back(fit_wheel_radius(drive, i, out.notes));
+
+  align_dead_reckoning(drive, out);
   if (warn)
     for (const auto& n : out.notes) warn(quote(m.path) + ": " + n);
   return out;
