@@ -427,19 +427,21 @@ std::vector<std::size_t> parse_job_list(const std::string& text, std::size_t cou
   return out;
 }
 
-RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const RunOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  RunSummary sum;
+namespace {
+
+/// The jobs of `given` (all when empty) to run: those not done (all with `rerun`), their run
+/// settings checked. Counts them into `sum`.
+std::vector<Job> pending_jobs(const Study& s, const std::vector<std::size_t>& given, bool rerun,
+                              RunSummary& sum) {
   std::vector<std::size_t> indices = given;
   if (indices.empty())
     for (std::size_t k = 0; k < s.job_count(); ++k) indices.push_back(k);
   sum.requested = indices.size();
-  // Resolved before the workers start: a bad setting stops the run before any job.
   std::vector<Job> pending;
   std::set<std::string> checked;
   for (std::size_t k : indices) {
     Job j = s.job(k);
-    if (!o.rerun && job_status(s, j).state == JobState::kDone) {
+    if (!rerun && job_status(s, j).state == JobState::kDone) {
       ++sum.already_done;
       continue;
     }
@@ -448,6 +450,124 @@ RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const
                                      std::to_string(k) + " (" + j.describe() + ")");
     pending.push_back(std::move(j));
   }
+  return pending;
+}
+
+/// The worker threads of run_jobs: each takes the next pending job until none is left, an
+/// error that is not a job's failure happens (`fatal_`) or an interrupt; the counts, the
+/// summary and the progress line are shared under `mutex_`.
+class JobWorkers {
+ public:
+  JobWorkers(const Study& s, const RunOptions& o, const std::vector<Job>& pending,
+             RunSummary& sum, std::chrono::steady_clock::time_point t0)
+      : s_(s), o_(o), pending_(pending), sum_(sum), t0_(t0),
+        tty_(o.progress && ::isatty(STDERR_FILENO)), total_(pending.size()) {}
+
+  /// Runs the jobs on `workers` threads; rethrows `fatal_`, or Interrupted.
+  void run(int workers);
+
+ private:
+  void progress_line();
+  void work();
+  void finished_job(const Job& j, const JobOutcome& r);
+
+  const Study& s_;
+  const RunOptions& o_;
+  const std::vector<Job>& pending_;
+  RunSummary& sum_;
+  const std::chrono::steady_clock::time_point t0_;
+  const bool tty_;
+  const std::size_t total_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::atomic<std::size_t> next_{0};
+  std::size_t finished_ = 0, running_ = 0;
+  std::exception_ptr fatal_;
+};
+
+void JobWorkers::progress_line() {
+  const double el = since(t0_);
+  std::string line = "\rstudy " + s_.name() + ": " + std::to_string(finished_) + "/" +
+                     std::to_string(total_) + " jobs";
+  if (sum_.already_done) line += " (+" + std::to_string(sum_.already_done) + " done before)";
+  if (sum_.failed) line += ", " + std::to_string(sum_.failed) + " failed";
+  line += ", " + std::to_string(running_) + " running, " + fmt(el, 0) + " s elapsed";
+  if (finished_ > 0 && finished_ < total_)
+    line += ", ~" +
+            fmt(el * static_cast<double>(total_ - finished_) / static_cast<double>(finished_), 0) +
+            " s left";
+  std::fprintf(stderr, "%s   ", line.c_str());
+  std::fflush(stderr);
+}
+
+void JobWorkers::work() {
+  for (std::size_t i = next_++; i < total_; i = next_++) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (fatal_ || interrupt_requested()) return;
+      ++running_;
+    }
+    JobOutcome r;
+    try {
+      r = run_job(s_, pending_[i], o_.job);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!fatal_) fatal_ = std::current_exception();
+      --running_;
+      cv_.notify_all();
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    finished_job(pending_[i], r);
+  }
+}
+
+/// Counts and logs a finished job (under `mutex_`).
+void JobWorkers::finished_job(const Job& j, const JobOutcome& r) {
+  --running_;
+  ++finished_;
+  std::string line = "[" + std::to_string(finished_) + "/" + std::to_string(total_) + "] job " +
+                     std::to_string(j.index) + " (" + j.describe() + "): ";
+  if (r.ok) {
+    ++sum_.done;
+    line += r.summary + " (" + fmt(r.timing.finished - r.timing.started, 1) + " s" +
+            (r.timing.generated ? ", dataset simulated" : "") + ")";
+  } else {
+    ++sum_.failed;
+    sum_.failures.emplace_back(j.index, r.error);
+    line += "FAILED: " + r.error;
+  }
+  if (o_.log && (!tty_ || !r.ok)) {
+    if (tty_) std::fprintf(stderr, "\r%*s\r", 100, "");
+    *o_.log << line << std::endl;
+  }
+  if (tty_) progress_line();
+  cv_.notify_all();
+}
+
+void JobWorkers::run(int workers) {
+  std::vector<std::thread> threads;
+  for (int k = 0; k < workers; ++k) threads.emplace_back([this] { work(); });
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (finished_ < total_ && !((fatal_ || interrupt_requested()) && running_ == 0)) {
+      cv_.wait_for(lock, std::chrono::milliseconds(interrupt_requested() ? 50 : 1000));
+      if (tty_) progress_line();
+    }
+  }
+  for (auto& t : threads) t.join();
+  if (tty_) std::fprintf(stderr, "\n");
+  if (fatal_) std::rethrow_exception(fatal_);
+  check_interrupt();  // interrupted between jobs
+}
+
+}  // namespace
+
+RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const RunOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RunSummary sum;
+  // Resolved before the workers start: a bad setting stops the run before any job.
+  const std::vector<Job> pending = pending_jobs(s, given, o.rerun, sum);
   if (pending.empty()) {
     sum.seconds = since(t0);
     return sum;
@@ -456,81 +576,8 @@ RunSummary run_jobs(const Study& s, const std::vector<std::size_t>& given, const
   fs::create_directories(s.jobs_dir(), ec);
   if (ec) throw InputError("'" + s.jobs_dir().string() + "': cannot create: " + ec.message());
 
-  std::mutex mutex;
-  std::condition_variable cv;
-  std::atomic<std::size_t> next{0};
-  std::size_t finished = 0, running = 0;
-  std::exception_ptr fatal;
-  const bool tty = o.progress && ::isatty(STDERR_FILENO);
-  const std::size_t total = pending.size();
-  auto progress_line = [&]() {
-    const double el = since(t0);
-    std::string line = "\rstudy " + s.name() + ": " + std::to_string(finished) + "/" +
-                       std::to_string(total) + " jobs";
-    if (sum.already_done) line += " (+" + std::to_string(sum.already_done) + " done before)";
-    if (sum.failed) line += ", " + std::to_string(sum.failed) + " failed";
-    line += ", " + std::to_string(running) + " running, " + fmt(el, 0) + " s elapsed";
-    if (finished > 0 && finished < total)
-      line += ", ~" +
-              fmt(el * static_cast<double>(total - finished) / static_cast<double>(finished), 0) +
-              " s left";
-    std::fprintf(stderr, "%s   ", line.c_str());
-    std::fflush(stderr);
-  };
-  auto worker = [&]() {
-    for (std::size_t i = next++; i < total; i = next++) {
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (fatal || interrupt_requested()) return;
-        ++running;
-      }
-      JobOutcome r;
-      try {
-        r = run_job(s, pending[i], o.job);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!fatal) fatal = std::current_exception();
-        --running;
-        cv.notify_all();
-        return;
-      }
-      std::lock_guard<std::mutex> lock(mutex);
-      --running;
-      ++finished;
-      const Job& j = pending[i];
-      std::string line = "[" + std::to_string(finished) + "/" + std::to_string(total) + "] job " +
-                         std::to_string(j.index) + " (" + j.describe() + "): ";
-      if (r.ok) {
-        ++sum.done;
-        line += r.summary + " (" + fmt(r.timing.finished - r.timing.started, 1) + " s" +
-                (r.timing.generated ? ", dataset simulated" : "") + ")";
-      } else {
-        ++sum.failed;
-        sum.failures.emplace_back(j.index, r.error);
-        line += "FAILED: " + r.error;
-      }
-      if (o.log && (!tty || !r.ok)) {
-        if (tty) std::fprintf(stderr, "\r%*s\r", 100, "");
-        *o.log << line << std::endl;
-      }
-      if (tty) progress_line();
-      cv.notify_all();
-    }
-  };
-  const int workers = std::max(1, std::min<int>(o.workers, static_cast<int>(total)));
-  std::vector<std::thread> threads;
-  for (int k = 0; k < workers; ++k) threads.emplace_back(worker);
-  {
-    std::unique_lock<std::mutex> lock(mutex);
-    while (finished < total && !((fatal || interrupt_requested()) && running == 0)) {
-      cv.wait_for(lock, std::chrono::milliseconds(interrupt_requested() ? 50 : 1000));
-      if (tty) progress_line();
-    }
-  }
-  for (auto& t : threads) t.join();
-  if (tty) std::fprintf(stderr, "\n");
-  if (fatal) std::rethrow_exception(fatal);
-  check_interrupt();  // interrupted between jobs
+  JobWorkers pool(s, o, pending, sum, t0);
+  pool.run(std::max(1, std::min<int>(o.workers, static_cast<int>(pending.size()))));
   std::sort(sum.failures.begin(), sum.failures.end());
   sum.seconds = since(t0);
   return sum;

@@ -83,179 +83,254 @@ std::string axis_role_name(AxisRole r) {
 
 // --- The generic report -----------------------------------------------------------------
 
-Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOptions& o) {
-  Report rep;
-  const Layout L(s);
-  const Grid g = grid_of(s, L, jobs);
-  const IntervalOptions& io = s.interval();
-  const auto& axes = s.axes();
-  const fs::path dir = s.results_dir();
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw InputError("'" + dir.string() + "': cannot create: " + ec.message());
+// What the generic report's parts read: the study, its jobs laid out, and the jobs not done.
+struct ReportContext {
+  ReportContext(const Study& study, const std::vector<JobEntry>& jobs);
 
-  std::vector<std::string> cond_names;
-  for (std::size_t a : L.cond) cond_names.push_back(axes[a].name);
-  std::string rep_names;
-  for (std::size_t a : L.rep) rep_names += (rep_names.empty() ? "" : " x ") + axes[a].name;
-
-  for (const auto& e : jobs)
-    if (e.record) ++rep.done;
+  const Study& s;
+  const Layout L;
+  const Grid g;
+  const IntervalOptions& io;
+  std::vector<std::string> cond_names;  ///< the condition axes' names
+  std::string rep_names;                ///< the replicate axes' names ("a x b")
   std::vector<const JobEntry*> not_done;
+};
+
+ReportContext::ReportContext(const Study& study, const std::vector<JobEntry>& jobs)
+    : s(study), L(study), g(grid_of(study, L, jobs)), io(study.interval()) {
+  const auto& axes = s.axes();
+  for (std::size_t a : L.cond) cond_names.push_back(axes[a].name);
+  for (std::size_t a : L.rep) rep_names += (rep_names.empty() ? "" : " x ") + axes[a].name;
   for (const auto& e : jobs)
     if (!e.record) not_done.push_back(&e);
+}
 
-  // report.md
-  std::ostringstream md;
+/// "job 7 (robot | 3 | triple): failed: ..." (Report::not_done).
+std::string not_done_line(const JobEntry& e) {
+  return "job " + std::to_string(e.job.index) + " (" + e.job.describe() +
+         "): " + job_state_name(e.status.state) +
+         (e.status.detail.empty() ? "" : ": " + e.status.detail);
+}
+
+/// The header of a markdown table: the condition columns (one "data" column if there is no
+/// condition axis), then `columns`.
+void table_header(std::ostream& os, const ReportContext& x,
+                  const std::vector<std::string>& columns) {
+  os << "|";
+  if (x.cond_names.empty()) os << " data |";
+  for (const auto& c : x.cond_names) os << " " << md_cell(c) << " |";
+  for (const auto& c : columns) os << " " << md_cell(c) << " |";
+  os << "\n|";
+  for (std::size_t i = 0; i < std::max<std::size_t>(1, x.cond_names.size()) + columns.size(); ++i)
+    os << "---|";
+  os << "\n";
+}
+
+/// The start of condition `c`'s row in a markdown table: its labels (the study's name if
+/// there is no condition axis).
+void row_start(std::ostream& os, const ReportContext& x, std::size_t c) {
+  os << "|";
+  if (x.cond_names.empty()) os << " " << md_cell(x.s.name()) << " |";
+  for (const auto& l : x.L.labels(c, x.L.cond, x.s)) os << " " << md_cell(l) << " |";
+}
+
+/// report.md's title and what the study and the cells of its tables are.
+void markdown_intro(std::ostream& md, const ReportContext& x, std::size_t jobs, std::size_t done) {
+  const Study& s = x.s;
+  const IntervalOptions& io = x.io;
   md << "# Study: " << s.name() << "\n\n";
   if (!s.description().empty()) md << s.description() << "\n\n";
-  md << "Study file `" << s.file().string() << "`: " << jobs.size() << " jobs";
+  md << "Study file `" << s.file().string() << "`: " << jobs << " jobs";
   {
     std::string dims;
-    for (const auto& a : axes)
+    for (const auto& a : s.axes())
       dims += (dims.empty() ? "" : " x ") + std::to_string(a.values.size()) + " " + a.name;
     if (!dims.empty()) md << " (" << dims << ")";
   }
-  md << "; " << rep.done << " in this report";
-  if (!not_done.empty()) md << ", **" << not_done.size() << " not done** (listed at the end)";
+  md << "; " << done << " in this report";
+  if (!x.not_done.empty()) md << ", **" << x.not_done.size() << " not done** (listed at the end)";
   md << ".\n\n";
   md << "Each cell: mean ± standard deviation ["
      << interval_description(io.method, io.confidence, io.resamples) << "] over the "
-     << (rep_names.empty() ? "jobs" : rep_names + " replicates") << " (n = " << L.replicates
+     << (x.rep_names.empty() ? "jobs" : x.rep_names + " replicates") << " (n = " << x.L.replicates
      << " per cell unless noted). Drift rate: paper Section VI-B (l = 100 m) in % of the distance; "
         "heading RMSE "
         "in degrees; every run evaluated against the truth as `wheelins evaluate` does.\n\n";
-  auto header = [&](std::ostream& os, const std::vector<std::string>& columns) {
-    os << "|";
-    if (cond_names.empty()) os << " data |";
-    for (const auto& c : cond_names) os << " " << md_cell(c) << " |";
-    for (const auto& c : columns) os << " " << md_cell(c) << " |";
-    os << "\n|";
-    for (std::size_t i = 0; i < std::max<std::size_t>(1, cond_names.size()) + columns.size(); ++i)
-      os << "---|";
-    os << "\n";
-  };
-  auto row_start = [&](std::ostream& os, std::size_t c) {
-    os << "|";
-    if (cond_names.empty()) os << " " << md_cell(s.name()) << " |";
-    for (const auto& l : L.labels(c, L.cond, s)) os << " " << md_cell(l) << " |";
-  };
+}
+
+/// The drift rate and heading RMSE tables: per condition and configuration, the summary over
+/// the replicates.
+void markdown_metrics(std::ostream& md, const ReportContext& x) {
+  const Layout& L = x.L;
   for (int metric : {kDrift, kHeading}) {
     const Metric& m = kMetrics[metric];
     md << "## " << m.title << " (" << m.unit << ")\n\n";
-    header(md, L.config_labels);
+    table_header(md, x, L.config_labels);
     for (std::size_t c = 0; c < L.conditions; ++c) {
-      row_start(md, c);
+      row_start(md, x, c);
       for (std::size_t k = 0; k < L.configurations; ++k)
         md << " "
-           << cell(summarize(values_of(g.records[c][k], metric), io), m.decimals, L.replicates)
+           << cell(summarize(values_of(x.g.records[c][k], metric), x.io), m.decimals, L.replicates)
            << " |";
       md << "\n";
     }
     md << "\n";
   }
-  // The pairs compared: the study's `compare`, else every configuration against the first.
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  std::vector<std::string> titles;
-  for (const auto& [a, b] : s.compare()) {
-    const auto ia = std::find(L.config_labels.begin(), L.config_labels.end(), a) - L.config_labels.begin();
-    const auto ib = std::find(L.config_labels.begin(), L.config_labels.end(), b) - L.config_labels.begin();
-    pairs.emplace_back(static_cast<std::size_t>(ia), static_cast<std::size_t>(ib));
-    titles.push_back(b + " - " + a);
+}
+
+/// The index of the configuration labelled `label`.
+std::size_t config_index(const Layout& L, const std::string& label) {
+  return static_cast<std::size_t>(std::find(L.config_labels.begin(), L.config_labels.end(), label) -
+                                  L.config_labels.begin());
+}
+
+using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
+
+struct Comparisons {
+  Pairs pairs;                      ///< the study's `compare`: (A, B) configuration indices
+  std::vector<std::string> titles;  ///< "B - A" per pair
+  Pairs plot_pairs;                 ///< the pairs in the paired plot
+};
+
+// The pairs compared: the study's `compare`, else every configuration against the first.
+Comparisons comparisons(const ReportContext& x) {
+  Comparisons cmp;
+  for (const auto& [a, b] : x.s.compare()) {
+    cmp.pairs.emplace_back(config_index(x.L, a), config_index(x.L, b));
+    cmp.titles.push_back(b + " - " + a);
   }
-  std::vector<std::pair<std::size_t, std::size_t>> plot_pairs = pairs;
-  if (plot_pairs.empty())
-    for (std::size_t k = 1; k < L.configurations; ++k) plot_pairs.emplace_back(0, k);
-  if (!s.compare().empty()) {
-    md << "## Paired differences (B - A on the same data)\n\n"
-       << "Each cell: mean of the differences B - A over the replicates both have ± their standard "
-          "deviation ["
-       << interval_description(io.method, io.confidence, io.resamples)
-       << " of the differences]; then in how many pairs B was lower. Negative: B is better. An "
-          "interval "
-          "that excludes 0 means the difference is larger than the spread between replicates "
-          "explains.\n\n";
-    for (int metric : {kDrift, kHeading}) {
-      const Metric& m = kMetrics[metric];
-      md << "### " << m.title << " (" << m.unit << ")\n\n";
-      header(md, titles);
-      for (std::size_t c = 0; c < L.conditions; ++c) {
-        row_start(md, c);
-        for (const auto& [a, b] : pairs) {
-          const Paired p = paired(g.records[c][a], g.records[c][b], metric, io);
-          md << " " << cell(p.s, m.decimals, L.replicates);
-          if (p.s.n > 0) md << "; lower in " << p.b_lower << "/" << p.s.n;
-          md << " |";
-        }
-        md << "\n";
+  cmp.plot_pairs = cmp.pairs;
+  if (cmp.plot_pairs.empty())
+    for (std::size_t k = 1; k < x.L.configurations; ++k) cmp.plot_pairs.emplace_back(0, k);
+  return cmp;
+}
+
+/// The tables of the paired differences of the study's `compare` pairs.
+void markdown_differences(std::ostream& md, const ReportContext& x, const Comparisons& cmp) {
+  const IntervalOptions& io = x.io;
+  md << "## Paired differences (B - A on the same data)\n\n"
+     << "Each cell: mean of the differences B - A over the replicates both have ± their standard "
+        "deviation ["
+     << interval_description(io.method, io.confidence, io.resamples)
+     << " of the differences]; then in how many pairs B was lower. Negative: B is better. An "
+        "interval "
+        "that excludes 0 means the difference is larger than the spread between replicates "
+        "explains.\n\n";
+  for (int metric : {kDrift, kHeading}) {
+    const Metric& m = kMetrics[metric];
+    md << "### " << m.title << " (" << m.unit << ")\n\n";
+    table_header(md, x, cmp.titles);
+    for (std::size_t c = 0; c < x.L.conditions; ++c) {
+      row_start(md, x, c);
+      for (const auto& [a, b] : cmp.pairs) {
+        const Paired p = paired(x.g.records[c][a], x.g.records[c][b], metric, io);
+        md << " " << cell(p.s, m.decimals, x.L.replicates);
+        if (p.s.n > 0) md << "; lower in " << p.b_lower << "/" << p.s.n;
+        md << " |";
       }
       md << "\n";
     }
+    md << "\n";
   }
+}
+
+/// The consistency table: per condition and configuration, the means of the share of epochs
+/// within 3 sigma and of the horizontal NEES.
+void markdown_consistency(std::ostream& md, const ReportContext& x) {
+  const Layout& L = x.L;
   md << "## Consistency (means over the replicates)\n\n"
      << "Share of epochs whose horizontal error is within 3 sigma of the filter's own north/east "
         "covariance "
         "(>= 89 % if the filter is consistent) / mean horizontal NEES (2 if consistent).\n\n";
-  header(md, L.config_labels);
+  table_header(md, x, L.config_labels);
   for (std::size_t c = 0; c < L.conditions; ++c) {
-    row_start(md, c);
+    row_start(md, x, c);
     for (std::size_t k = 0; k < L.configurations; ++k) {
-      const Summary a = summarize(values_of(g.records[c][k], k3Sigma), io);
-      const Summary b = summarize(values_of(g.records[c][k], kNees), io);
+      const Summary a = summarize(values_of(x.g.records[c][k], k3Sigma), x.io);
+      const Summary b = summarize(values_of(x.g.records[c][k], kNees), x.io);
       md << " " << (a.n ? fmt(a.mean, 1) + " % / " + fmt(b.mean, 2) : std::string("-")) << " |";
     }
     md << "\n";
   }
   md << "\n";
+}
 
-  // Plots.
+/// The plots' files, and their section of report.md.
+PlotFiles plots_section(std::ostream& md, const ReportContext& x, const Pairs& plot_pairs) {
+  const Study& s = x.s;
+  const IntervalOptions& io = x.io;
   PlotFiles plots;
-  if (o.plots && rep.done > 0) {
-    add_metric_plot(plots, s, L, g, kDrift, "drift");
-    add_metric_plot(plots, s, L, g, kHeading, "heading");
-    md << "## Plots\n\n`plots/drift.png`, `plots/heading.png`: per condition (x axis) and "
-          "configuration, the mean (square) and its "
-       << interval_description(io.method, io.confidence, io.resamples)
-       << " (error bars), with every job as a small point";
-    if (!plot_pairs.empty()) {
-      add_paired_plot(plots, s, L, g, kDrift, plot_pairs, "paired_drift");
-      md << "; `plots/paired_drift.png`: the paired differences B - A of the drift rate, run by run on the "
-            "same data ("
-         << (s.compare().empty() ? "every configuration against the first" : "the study's `compare` pairs")
-         << "), each pair a small point, their mean and its interval; below the dashed zero line B is better";
-    }
-    md << " (data in `plots/data/`, gnuplot scripts `plots/*.gp`).\n\n";
+  add_metric_plot(plots, s, x.L, x.g, kDrift, "drift");
+  add_metric_plot(plots, s, x.L, x.g, kHeading, "heading");
+  md << "## Plots\n\n`plots/drift.png`, `plots/heading.png`: per condition (x axis) and "
+        "configuration, the mean (square) and its "
+     << interval_description(io.method, io.confidence, io.resamples)
+     << " (error bars), with every job as a small point";
+  if (!plot_pairs.empty()) {
+    add_paired_plot(plots, s, x.L, x.g, kDrift, plot_pairs, "paired_drift");
+    md << "; `plots/paired_drift.png`: the paired differences B - A of the drift rate, run by run "
+          "on the "
+          "same data ("
+       << (s.compare().empty() ? "every configuration against the first"
+                               : "the study's `compare` pairs")
+       << "), each pair a small point, their mean and its interval; below the dashed zero line B "
+          "is better";
   }
+  md << " (data in `plots/data/`, gnuplot scripts `plots/*.gp`).\n\n";
+  return plots;
+}
 
-  if (!not_done.empty()) {
-    md << "## Jobs not in this report\n\n| job | state | ";
-    for (const auto& a : axes) md << md_cell(a.name) << " | ";
-    md << "detail |\n|---|---|";
-    for (std::size_t i = 0; i < axes.size(); ++i) md << "---|";
-    md << "---|\n";
-    for (const auto* e : not_done) {
-      md << "| " << e->job.index << " | " << job_state_name(e->status.state) << " | ";
-      for (const auto& l : e->job.labels) md << md_cell(l) << " | ";
-      md << md_cell(e->status.detail) << " |\n";
-      rep.not_done.push_back("job " + std::to_string(e->job.index) + " (" + e->job.describe() +
-                             "): " + job_state_name(e->status.state) +
-                             (e->status.detail.empty() ? "" : ": " + e->status.detail));
-    }
-    md << "\n";
+/// The table of the jobs not in the report.
+void markdown_not_done(std::ostream& md, const ReportContext& x) {
+  const auto& axes = x.s.axes();
+  md << "## Jobs not in this report\n\n| job | state | ";
+  for (const auto& a : axes) md << md_cell(a.name) << " | ";
+  md << "detail |\n|---|---|";
+  for (std::size_t i = 0; i < axes.size(); ++i) md << "---|";
+  md << "---|\n";
+  for (const auto* e : x.not_done) {
+    md << "| " << e->job.index << " | " << job_state_name(e->status.state) << " | ";
+    for (const auto& l : e->job.labels) md << md_cell(l) << " | ";
+    md << md_cell(e->status.detail) << " |\n";
   }
-  rep.markdown = md.str();
+  md << "\n";
+}
 
-  // summary.csv, differences.csv
-  std::string header_csv;
-  for (const auto& c : cond_names) header_csv += csv_field(c) + ",";
-  auto cond_csv = [&](std::size_t c) {
-    std::string t;
-    for (const auto& l : L.labels(c, L.cond, s)) t += csv_field(l) + ",";
-    return t;
-  };
-  std::string summary_csv = header_csv + "configuration,metric,n,mean,sd,ci_lo,ci_hi\n";
-  std::string diff_csv = header_csv + "a,b,metric,n,mean_b_minus_a,sd,ci_lo,ci_hi,b_lower\n";
+// summary.csv, differences.csv and report.json.
+struct DataTables {
+  std::string summary_csv, diff_csv;
   JsonWriter js;
+};
+
+/// Condition `c`'s CSV fields, each followed by a comma.
+std::string cond_csv(const ReportContext& x, std::size_t c) {
+  std::string t;
+  for (const auto& l : x.L.labels(c, x.L.cond, x.s)) t += csv_field(l) + ",";
+  return t;
+}
+
+/// Condition `c`'s labels as the JSON object "condition".
+void cond_json(JsonWriter& js, const ReportContext& x, std::size_t c) {
+  js.begin_object("condition");
+  const auto labels = x.L.labels(c, x.L.cond, x.s);
+  for (std::size_t i = 0; i < labels.size(); ++i) js.str(x.cond_names[i].c_str(), labels[i]);
+  js.end_object();
+}
+
+/// `sm` as the JSON object `key`, left open.
+void stat_json(JsonWriter& js, const char* key, const Summary& sm) {
+  js.begin_object(key)
+      .integer("n", static_cast<std::int64_t>(sm.n))
+      .num("mean", sm.mean)
+      .num("sd", sm.sd)
+      .num("ci_lo", sm.lo)
+      .num("ci_hi", sm.hi);
+}
+
+/// report.json's head: the study, the interval, the axes and the jobs (the object left open).
+void json_head(JsonWriter& js, const ReportContext& x, std::size_t jobs, std::size_t done) {
+  const Study& s = x.s;
+  const IntervalOptions& io = x.io;
   js.begin_object();
   js.str("format", "wheelins-study-report-1");
   js.str("study", s.name());
@@ -266,7 +341,7 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
       .str("description", interval_description(io.method, io.confidence, io.resamples))
       .end_object();
   js.begin_array("axes");
-  for (const auto& a : axes) {
+  for (const auto& a : s.axes()) {
     std::vector<std::string> labels;
     for (const auto& v : a.values) labels.push_back(v.label);
     js.begin_object()
@@ -277,10 +352,10 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
   }
   js.end_array();
   js.begin_object("jobs")
-      .integer("total", static_cast<std::int64_t>(jobs.size()))
-      .integer("done", static_cast<std::int64_t>(rep.done));
+      .integer("total", static_cast<std::int64_t>(jobs))
+      .integer("done", static_cast<std::int64_t>(done));
   js.begin_array("not_done");
-  for (const auto* e : not_done)
+  for (const auto* e : x.not_done)
     js.begin_object()
         .integer("job", static_cast<std::int64_t>(e->job.index))
         .str("state", job_state_name(e->status.state))
@@ -288,111 +363,146 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
         .str("detail", e->status.detail)
         .end_object();
   js.end_array().end_object();
-  auto cond_json = [&](std::size_t c) {
-    js.begin_object("condition");
-    const auto labels = L.labels(c, L.cond, s);
-    for (std::size_t i = 0; i < labels.size(); ++i) js.str(cond_names[i].c_str(), labels[i]);
-    js.end_object();
-  };
-  auto stat_json = [&](const char* key, const Summary& sm) {
-    js.begin_object(key)
-        .integer("n", static_cast<std::int64_t>(sm.n))
-        .num("mean", sm.mean)
-        .num("sd", sm.sd)
-        .num("ci_lo", sm.lo)
-        .num("ci_hi", sm.hi);
-  };
+}
+
+/// Per condition and configuration, the summary of every metric: summary.csv's rows and
+/// report.json's "summary".
+void summary_rows(DataTables& t, const ReportContext& x) {
+  const Layout& L = x.L;
+  JsonWriter& js = t.js;
   js.begin_array("summary");
   for (std::size_t c = 0; c < L.conditions; ++c)
     for (std::size_t k = 0; k < L.configurations; ++k) {
       js.begin_object();
-      cond_json(c);
+      cond_json(js, x, c);
       js.str("configuration", L.config_labels[k]);
       js.begin_object("metrics");
       for (int m = 0; m < kMetricCount; ++m) {
-        const Summary sm = summarize(values_of(g.records[c][k], m), io);
-        summary_csv += cond_csv(c) + csv_field(L.config_labels[k]) + "," + kMetrics[m].key + "," +
-                       std::to_string(sm.n) + "," + exact(sm.mean) + "," + exact(sm.sd) + "," +
-                       exact(sm.lo) + "," + exact(sm.hi) + "\n";
-        stat_json(kMetrics[m].key, sm);
+        const Summary sm = summarize(values_of(x.g.records[c][k], m), x.io);
+        t.summary_csv += cond_csv(x, c) + csv_field(L.config_labels[k]) + "," + kMetrics[m].key +
+                         "," + std::to_string(sm.n) + "," + exact(sm.mean) + "," + exact(sm.sd) +
+                         "," + exact(sm.lo) + "," + exact(sm.hi) + "\n";
+        stat_json(js, kMetrics[m].key, sm);
         js.end_object();
       }
       js.end_object().end_object();
     }
   js.end_array();
+}
+
+/// Per condition and `compare` pair, the paired differences of every metric:
+/// differences.csv's rows and report.json's "differences".
+void difference_rows(DataTables& t, const ReportContext& x) {
+  JsonWriter& js = t.js;
   js.begin_array("differences");
-  for (std::size_t c = 0; c < L.conditions; ++c)
-    for (const auto& [a, b] : s.compare()) {
-      const std::size_t ia = static_cast<std::size_t>(
-          std::find(L.config_labels.begin(), L.config_labels.end(), a) - L.config_labels.begin());
-      const std::size_t ib = static_cast<std::size_t>(
-          std::find(L.config_labels.begin(), L.config_labels.end(), b) - L.config_labels.begin());
+  for (std::size_t c = 0; c < x.L.conditions; ++c)
+    for (const auto& [a, b] : x.s.compare()) {
+      const std::size_t ia = config_index(x.L, a);
+      const std::size_t ib = config_index(x.L, b);
       js.begin_object();
-      cond_json(c);
+      cond_json(js, x, c);
       js.str("a", a).str("b", b);
       js.begin_object("metrics");
       for (int m = 0; m < kMetricCount; ++m) {
-        const Paired p = paired(g.records[c][ia], g.records[c][ib], m, io);
-        diff_csv += cond_csv(c) + csv_field(a) + "," + csv_field(b) + "," + kMetrics[m].key + "," +
-                    std::to_string(p.s.n) + "," + exact(p.s.mean) + "," + exact(p.s.sd) + "," +
-                    exact(p.s.lo) + "," + exact(p.s.hi) + "," + std::to_string(p.b_lower) + "\n";
-        stat_json(kMetrics[m].key, p.s);
+        const Paired p = paired(x.g.records[c][ia], x.g.records[c][ib], m, x.io);
+        t.diff_csv += cond_csv(x, c) + csv_field(a) + "," + csv_field(b) + "," + kMetrics[m].key +
+                      "," + std::to_string(p.s.n) + "," + exact(p.s.mean) + "," + exact(p.s.sd) +
+                      "," + exact(p.s.lo) + "," + exact(p.s.hi) + "," + std::to_string(p.b_lower) +
+                      "\n";
+        stat_json(js, kMetrics[m].key, p.s);
         js.integer("b_lower", static_cast<std::int64_t>(p.b_lower));
         js.end_object();
       }
       js.end_object().end_object();
     }
   js.end_array();
-  js.end_object();
+}
 
-  // jobs.csv and timing.csv
-  std::string jobs_csv = "job,";
-  for (const auto& a : axes) jobs_csv += csv_field(a.name) + ",";
-  jobs_csv += "state,";
-  for (const auto& m : kMetrics) jobs_csv += std::string(m.key) + ",";
-  jobs_csv += "distance_m,epochs,fault_events,modules,data,detail\n";
-  std::string timing_csv =
+DataTables data_tables(const ReportContext& x, std::size_t jobs, std::size_t done) {
+  std::string header_csv;
+  for (const auto& c : x.cond_names) header_csv += csv_field(c) + ",";
+  DataTables t;
+  t.summary_csv = header_csv + "configuration,metric,n,mean,sd,ci_lo,ci_hi\n";
+  t.diff_csv = header_csv + "a,b,metric,n,mean_b_minus_a,sd,ci_lo,ci_hi,b_lower\n";
+  json_head(t.js, x, jobs, done);
+  summary_rows(t, x);
+  difference_rows(t, x);
+  t.js.end_object();
+  return t;
+}
+
+// jobs.csv and timing.csv
+struct JobTables {
+  std::string jobs_csv, timing_csv;
+};
+
+/// Job `e`'s row of jobs.csv.
+std::string jobs_row(const JobEntry& e) {
+  std::string row = std::to_string(e.job.index) + ",";
+  for (const auto& l : e.job.labels) row += csv_field(l) + ",";
+  row += std::string(job_state_name(e.status.state)) + ",";
+  std::string mods;
+  if (e.record) {
+    for (const auto& m : kMetrics) row += exact(m.get(*e.record)) + ",";
+    row += exact(e.record->eval.distance) + "," + std::to_string(e.record->stats.epochs) + "," +
+           std::to_string(e.record->fault_events) + ",";
+    for (const auto& m : e.record->modules) mods += (mods.empty() ? "" : "+") + m;
+  } else {
+    for (int m = 0; m < kMetricCount; ++m) row += ",";
+    row += ",,,";
+  }
+  return row + csv_field(mods) + "," + csv_field(e.job.dataset.describe()) + "," +
+         csv_field(e.status.detail) + "\n";
+}
+
+/// Done job `e`'s row of timing.csv.
+std::string timing_row(const JobEntry& e) {
+  const JobTiming& t = e.record->timing;
+  return std::to_string(e.job.index) + ",done," + csv_field(t.host) + "," +
+         (t.generated ? "1" : "0") + "," + exact(t.dataset) + "," + exact(t.setup) + "," +
+         exact(t.navigate) + "," + exact(t.finish) + "," + exact(t.filter) + "," +
+         exact(t.started) + "," + exact(t.finished) + "\n";
+}
+
+/// jobs.csv and timing.csv; the done jobs' time and their span into `rep`.
+JobTables job_tables(const Study& s, const std::vector<JobEntry>& jobs, Report& rep) {
+  JobTables t;
+  t.jobs_csv = "job,";
+  for (const auto& a : s.axes()) t.jobs_csv += csv_field(a.name) + ",";
+  t.jobs_csv += "state,";
+  for (const auto& m : kMetrics) t.jobs_csv += std::string(m.key) + ",";
+  t.jobs_csv += "distance_m,epochs,fault_events,modules,data,detail\n";
+  t.timing_csv =
       "job,state,host,dataset_generated,dataset_s,setup_s,navigate_s,finish_s,filter_s,started_"
       "unix,finished_unix\n";
   double first = INFINITY, last = -INFINITY;
   for (const auto& e : jobs) {
-    jobs_csv += std::to_string(e.job.index) + ",";
-    for (const auto& l : e.job.labels) jobs_csv += csv_field(l) + ",";
-    jobs_csv += std::string(job_state_name(e.status.state)) + ",";
-    std::string mods;
-    if (e.record) {
-      for (const auto& m : kMetrics) jobs_csv += exact(m.get(*e.record)) + ",";
-      jobs_csv += exact(e.record->eval.distance) + "," + std::to_string(e.record->stats.epochs) +
-                  "," + std::to_string(e.record->fault_events) + ",";
-      for (const auto& m : e.record->modules) mods += (mods.empty() ? "" : "+") + m;
-      const JobTiming& t = e.record->timing;
-      timing_csv += std::to_string(e.job.index) + ",done," + csv_field(t.host) + "," +
-                    (t.generated ? "1" : "0") + "," + exact(t.dataset) + "," + exact(t.setup) +
-                    "," + exact(t.navigate) + "," + exact(t.finish) + "," + exact(t.filter) + "," +
-                    exact(t.started) + "," + exact(t.finished) + "\n";
-      rep.job_seconds += t.finished - t.started;
-      first = std::min(first, t.started);
-      last = std::max(last, t.finished);
-    } else {
-      for (int m = 0; m < kMetricCount; ++m) jobs_csv += ",";
-      jobs_csv += ",,,";
-    }
-    jobs_csv += csv_field(mods) + "," + csv_field(e.job.dataset.describe()) + "," +
-                csv_field(e.status.detail) + "\n";
+    t.jobs_csv += jobs_row(e);
+    if (!e.record) continue;
+    const JobTiming& tm = e.record->timing;
+    t.timing_csv += timing_row(e);
+    rep.job_seconds += tm.finished - tm.started;
+    first = std::min(first, tm.started);
+    last = std::max(last, tm.finished);
   }
   rep.span_seconds = rep.done ? last - first : 0.0;
+  return t;
+}
 
-  const std::vector<std::pair<std::string, std::string>> files = {
-      {"report.md", rep.markdown}, {"summary.csv", summary_csv}, {"differences.csv", diff_csv},
-      {"jobs.csv", jobs_csv},      {"report.json", js.text()},   {"timing.csv", timing_csv}};
-  // The report replaces only what a report wrote here (files.hpp): every file is checked
-  // before the first is written.
+using TextFiles = std::vector<std::pair<std::string, std::string>>;
+
+std::string first_line(const std::string& t) { return t.substr(0, t.find('\n')); }
+
+// The report replaces only what a report wrote here (files.hpp): every file is checked
+// before the first is written.
+void write_report_files(Report& rep, const fs::path& dir, const TextFiles& files,
+                        const PlotFiles& plots, const ReportOptions& o) {
   ReportFiles ours(dir);
-  auto first_line = [](const std::string& t) { return t.substr(0, t.find('\n')); };
   for (const auto& [name, text] : files) ours.check(name, first_line(text));
   std::vector<fs::path> written;
   if (!plots.names.empty()) {
-    for (const auto& [rel, text] : plots.files) ours.check(fs::path("plots") / rel, first_line(text));
+    for (const auto& [rel, text] : plots.files)
+      ours.check(fs::path("plots") / rel, first_line(text));
     if (o.plot.render)
       for (const auto& n : plots.names) ours.check(fs::path("plots") / (n + ".png"), "\x89PNG\r");
   }
@@ -403,6 +513,7 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
   }
   if (!plots.names.empty()) {
     const fs::path pdir = dir / "plots";
+    std::error_code ec;
     fs::create_directories(pdir / "data", ec);
     for (const auto& [rel, text] : plots.files) {
       write_file_atomic(pdir / rel, text);
@@ -416,6 +527,38 @@ Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOp
       }
   }
   ours.add(written);
+}
+
+Report generic_report(const Study& s, std::vector<JobEntry> jobs, const ReportOptions& o) {
+  Report rep;
+  const ReportContext x(s, jobs);
+  const fs::path dir = s.results_dir();
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError("'" + dir.string() + "': cannot create: " + ec.message());
+  for (const auto& e : jobs)
+    if (e.record) ++rep.done;
+
+  // report.md
+  std::ostringstream md;
+  markdown_intro(md, x, jobs.size(), rep.done);
+  markdown_metrics(md, x);
+  const Comparisons cmp = comparisons(x);
+  if (!s.compare().empty()) markdown_differences(md, x, cmp);
+  markdown_consistency(md, x);
+  // Plots.
+  PlotFiles plots;
+  if (o.plots && rep.done > 0) plots = plots_section(md, x, cmp.plot_pairs);
+  if (!x.not_done.empty()) markdown_not_done(md, x);
+  for (const auto* e : x.not_done) rep.not_done.push_back(not_done_line(*e));
+  rep.markdown = md.str();
+
+  const DataTables data = data_tables(x, jobs.size(), rep.done);
+  const JobTables job = job_tables(s, jobs, rep);
+  const TextFiles files = {{"report.md", rep.markdown},        {"summary.csv", data.summary_csv},
+                           {"differences.csv", data.diff_csv}, {"jobs.csv", job.jobs_csv},
+                           {"report.json", data.js.text()},    {"timing.csv", job.timing_csv}};
+  write_report_files(rep, dir, files, plots, o);
   rep.jobs = std::move(jobs);
   return rep;
 }
@@ -440,9 +583,7 @@ Report experiment_report(const Study& s, std::vector<JobEntry> jobs, const Repor
   double first = INFINITY, last = -INFINITY;
   for (const auto& e : jobs) {
     if (!e.record) {
-      rep.not_done.push_back("job " + std::to_string(e.job.index) + " (" + e.job.describe() +
-                             "): " + job_state_name(e.status.state) +
-                             (e.status.detail.empty() ? "" : ": " + e.status.detail));
+      rep.not_done.push_back(not_done_line(e));
       continue;
     }
     ++rep.done;

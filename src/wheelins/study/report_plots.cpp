@@ -42,9 +42,60 @@ struct GroupPlot {
   bool zero_line = false;
 };
 
-void write_group_plot(PlotFiles& out, const Study& s, const Layout& L, const GroupPlot& p) {
-  const IntervalOptions& io = s.interval();
+/// Condition `c`'s label: its labels joined by " / " (the study's name if there is no
+/// condition axis).
+std::string condition_label(const Study& s, const Layout& L, std::size_t c) {
+  std::string label;
+  for (const auto& l : L.labels(c, L.cond, s)) label += (label.empty() ? "" : " / ") + l;
+  return label.empty() ? s.name() : label;
+}
+
+/// The range of the values drawn (0 always in it).
+struct YRange {
+  double ymax = 0.0, ymin = 0.0;
+  void grow(double v) {
+    if (std::isfinite(v)) ymax = std::max(ymax, v), ymin = std::min(ymin, v);
+  }
+};
+
+/// Condition `c`'s fields of the summary CSV: per series the mean and its interval (the mean
+/// alone below two values).
+std::string summary_fields(const GroupPlot& p, std::size_t c, const IntervalOptions& io, YRange& y) {
+  std::string fields;
+  for (std::size_t k = 0; k < p.series.size(); ++k) {
+    std::vector<double> v;
+    for (double x : p.values[c][k])
+      if (std::isfinite(x)) v.push_back(x);
+    const Summary sm = summarize(v, io);
+    fields += "," + exact(sm.mean) + "," + exact(sm.n >= 2 ? sm.lo : sm.mean) + "," +
+              exact(sm.n >= 2 ? sm.hi : sm.mean);
+    if (sm.n >= 2) y.grow(sm.hi), y.grow(sm.lo);
+  }
+  return fields;
+}
+
+/// Condition `c`'s rows of the jobs CSV: one per replicate with a value, per series.
+std::string job_rows(const GroupPlot& p, std::size_t c, YRange& y) {
   const std::size_t K = p.series.size();
+  std::size_t reps = 0;
+  for (std::size_t k = 0; k < K; ++k) reps = std::max(reps, p.values[c][k].size());
+  std::string rows;
+  for (std::size_t r = 0; r < reps; ++r) {
+    std::string row = std::to_string(c);
+    bool any = false;
+    for (std::size_t k = 0; k < K; ++k) {
+      const double v = r < p.values[c][k].size() ? p.values[c][k][r] : std::nan("");
+      if (std::isfinite(v)) any = true, y.grow(v);
+      row += "," + exact(v);
+    }
+    if (any) rows += row + "\n";
+  }
+  return rows;
+}
+
+/// The plot's data files: data/`name`_summary.csv (per condition, each series' mean and
+/// interval) and data/`name`_jobs.csv (every replicate's values). Returns the range drawn.
+YRange write_group_data(PlotFiles& out, const Study& s, const Layout& L, const GroupPlot& p) {
   std::string summary = "condition,label";
   std::string jobs = "condition";
   for (const auto& c : p.series) {
@@ -53,76 +104,59 @@ void write_group_plot(PlotFiles& out, const Study& s, const Layout& L, const Gro
   }
   summary += "\n";
   jobs += "\n";
-  double ymax = 0.0, ymin = 0.0;
-  auto grow = [&](double v) {
-    if (std::isfinite(v)) ymax = std::max(ymax, v), ymin = std::min(ymin, v);
-  };
-  auto condition_label = [&](std::size_t c) {
-    std::string label;
-    for (const auto& l : L.labels(c, L.cond, s)) label += (label.empty() ? "" : " / ") + l;
-    return label.empty() ? s.name() : label;
-  };
+  YRange y;
   for (std::size_t c = 0; c < L.conditions; ++c) {
-    std::string label = condition_label(c);
+    std::string label = condition_label(s, L, c);
     for (char& ch : label)
       if (ch == ',') ch = ';';
-    summary += std::to_string(c) + "," + label;
-    std::size_t reps = 0;
-    for (std::size_t k = 0; k < K; ++k) {
-      std::vector<double> v;
-      for (double x : p.values[c][k])
-        if (std::isfinite(x)) v.push_back(x);
-      reps = std::max(reps, p.values[c][k].size());
-      const Summary sm = summarize(v, io);
-      summary += "," + exact(sm.mean) + "," + exact(sm.n >= 2 ? sm.lo : sm.mean) + "," +
-                 exact(sm.n >= 2 ? sm.hi : sm.mean);
-      if (sm.n >= 2) grow(sm.hi), grow(sm.lo);
-    }
-    summary += "\n";
-    for (std::size_t r = 0; r < reps; ++r) {
-      std::string row = std::to_string(c);
-      bool any = false;
-      for (std::size_t k = 0; k < K; ++k) {
-        const double v = r < p.values[c][k].size() ? p.values[c][k][r] : std::nan("");
-        if (std::isfinite(v)) any = true, grow(v);
-        row += "," + exact(v);
-      }
-      if (any) jobs += row + "\n";
-    }
+    summary += std::to_string(c) + "," + label + summary_fields(p, c, s.interval(), y) + "\n";
+    jobs += job_rows(p, c, y);
   }
   out.files.emplace_back(fs::path("data") / (p.name + "_summary.csv"), summary);
   out.files.emplace_back(fs::path("data") / (p.name + "_jobs.csv"), jobs);
+  return y;
+}
 
-  const double width = 0.7 / static_cast<double>(K);
+/// The gnuplot script up to its plot command: the terminal, the titles, the axes and the key.
+/// `bars`: what the error bars are.
+std::string script_settings(const Study& s, const Layout& L, const GroupPlot& p, const YRange& y,
+                            const std::string& bars) {
+  const std::size_t K = p.series.size();
   const int px = static_cast<int>(
       std::clamp<double>(200.0 + 70.0 * static_cast<double>(L.conditions * K), 1200.0, 4000.0));
   std::string xtics, xlabel;
   std::size_t longest = 0;
   for (std::size_t c = 0; c < L.conditions; ++c) {
-    const std::string label = condition_label(c);
+    const std::string label = condition_label(s, L, c);
     longest = std::max(longest, label.size());
     xtics += (c ? ", " : "") + gq(label) + " " + std::to_string(c);
   }
   for (std::size_t a : L.cond) xlabel += (xlabel.empty() ? "" : " / ") + s.axes()[a].name;
   xlabel = xlabel.empty() ? "the study (one condition)" : "condition: " + xlabel;
+  const double ymin = y.ymin, ymax = y.ymax;
   const double lo = ymin < 0.0 ? 1.1 * ymin : 0.0, hi = ymax > 0.0 ? 1.1 * ymax : (ymin < 0.0 ? 0.0 : 1.0);
   const int bmargin = static_cast<int>(std::clamp<std::size_t>(5 + longest / 2, 6, 18));
-  const std::string bars = interval_description(io.method, io.confidence, io.resamples);
-  std::string gp = "# " + p.title + ": mean and " + bars + " per series; small points: " + p.what +
-                   ".\n"
-                   "# Written by `wheelins study report`; edit and re-run in this directory: gnuplot " +
-                   p.name + ".gp\n" + "if (!exists(\"outfile\")) outfile = " + gq(p.name + ".png") +
-                   "\nset terminal pngcairo size " + std::to_string(px) +
-                   ",800 noenhanced font \"Sans,13\" linewidth 1.3\n"
-                   "set output outfile\nset datafile separator \",\"\nset grid ytics lc rgb \"#d0d0d0\"\n"
-                   "set title " + gq(p.title + " - " + s.name()) + " font \",15\"\n" +
-                   "set ylabel " + gq(p.ylabel) + "\nset xlabel " + gq(xlabel) + "\n" +
-                   "set xrange [-0.5:" + std::to_string(L.conditions) + "-0.5]\nset yrange [" + exact(lo) + ":" +
-                   exact(hi) + "]\n" + "set xtics (" + xtics + ") rotate by -25 left nomirror\nset bmargin " +
-                   std::to_string(bmargin) + "\n" + "set key outside top center horizontal samplen 2\n" +
-                   (p.zero_line ? "set arrow from graph 0, first 0 to graph 1, first 0 nohead lc rgb \"#404040\" dt 2\n"
-                                : "") +
-                   "plot \\\n";
+  return "# " + p.title + ": mean and " + bars + " per series; small points: " + p.what +
+         ".\n"
+         "# Written by `wheelins study report`; edit and re-run in this directory: gnuplot " +
+         p.name + ".gp\n" + "if (!exists(\"outfile\")) outfile = " + gq(p.name + ".png") +
+         "\nset terminal pngcairo size " + std::to_string(px) +
+         ",800 noenhanced font \"Sans,13\" linewidth 1.3\n"
+         "set output outfile\nset datafile separator \",\"\nset grid ytics lc rgb \"#d0d0d0\"\n"
+         "set title " + gq(p.title + " - " + s.name()) + " font \",15\"\n" +
+         "set ylabel " + gq(p.ylabel) + "\nset xlabel " + gq(xlabel) + "\n" +
+         "set xrange [-0.5:" + std::to_string(L.conditions) + "-0.5]\nset yrange [" + exact(lo) + ":" +
+         exact(hi) + "]\n" + "set xtics (" + xtics + ") rotate by -25 left nomirror\nset bmargin " +
+         std::to_string(bmargin) + "\n" + "set key outside top center horizontal samplen 2\n" +
+         (p.zero_line ? "set arrow from graph 0, first 0 to graph 1, first 0 nohead lc rgb \"#404040\" dt 2\n"
+                      : "");
+}
+
+/// The gnuplot script's plot command: per series the jobs' points and the means with their
+/// error bars, then what the marks are. `bars`: what the error bars are.
+std::string plot_command(const GroupPlot& p, const std::string& bars) {
+  const std::size_t K = p.series.size();
+  const double width = 0.7 / static_cast<double>(K);
   std::vector<std::string> parts;
   for (std::size_t k = 0; k < K; ++k) {
     const double off = (static_cast<double>(k) - 0.5 * static_cast<double>(K - 1)) * width;
@@ -140,8 +174,16 @@ void write_group_plot(PlotFiles& out, const Study& s, const Layout& L, const Gro
   parts.push_back("  NaN with yerrorbars pt 5 ps 1.1 lw 2 lc rgb \"#000000\" title " +
                   gq("square and bars: mean and its " + bars));
   parts.push_back("  NaN with points pt 7 ps 0.5 lc rgb \"#000000\" title " + gq("small points: " + p.what));
+  std::string gp = "plot \\\n";
   for (std::size_t i = 0; i < parts.size(); ++i) gp += parts[i] + (i + 1 < parts.size() ? ", \\\n" : "\n");
-  out.files.emplace_back(p.name + ".gp", gp);
+  return gp;
+}
+
+void write_group_plot(PlotFiles& out, const Study& s, const Layout& L, const GroupPlot& p) {
+  const YRange y = write_group_data(out, s, L, p);
+  const IntervalOptions& io = s.interval();
+  const std::string bars = interval_description(io.method, io.confidence, io.resamples);
+  out.files.emplace_back(p.name + ".gp", script_settings(s, L, p, y, bars) + plot_command(p, bars));
   out.names.push_back(p.name);
 }
 

@@ -181,6 +181,277 @@ YAML::Node substitute(
   return YAML::Node(io_detail::format_double(op == '*' ? *x * *f : *x / *f));
 }
 
+/// Where a job's messages and relative paths start: "'FILE': job K" and the study's folder.
+struct JobContext {
+  std::string who;
+  fs::path dir;
+
+  fs::path rel(const std::string& p) const {
+    return (fs::path(p).is_absolute() ? fs::path(p) : fs::absolute(dir / p)).lexically_normal();
+  }
+  std::string text_of(const Setting& s) const {
+    if (!s.value.IsScalar() || s.value.Scalar().empty())
+      throw InputError(who + ": " + s.origin() + ": " + s.key + ": expected a text value");
+    return s.value.Scalar();
+  }
+  std::vector<std::string> list_of(const Setting& s) const {
+    std::vector<std::string> out;
+    if (s.value.IsScalar()) {
+      std::stringstream ss(s.value.Scalar());
+      for (std::string item; std::getline(ss, item, ',');)
+        if (!item.empty()) out.push_back(item);
+    } else if (s.value.IsSequence()) {
+      for (const auto& x : s.value) out.push_back(x.as<std::string>());
+    } else {
+      throw InputError(who + ": " + s.origin() + ": " + s.key + ": expected a list");
+    }
+    return out;
+  }
+};
+
+/// The settings of a job's data: a manifest, or simulator settings.
+struct DataSettings {
+  std::optional<fs::path> dataset;
+  std::string dataset_where, sim_where;
+  Tree sim_tree;
+  std::vector<std::string> sim_configs, sim_sets, faults, disable;
+  std::map<std::string, std::string> sim_origin;  // dotted simulator key -> where it was set
+  std::optional<std::vector<std::string>> only;
+  std::optional<std::string> wheel_noise;
+  std::optional<bool> earth_rotation;
+
+  void add_simulate(const Setting& s, const JobContext& cx);
+  std::string memo_key() const;
+};
+
+/// A `seed` or `simulate.KEY` setting.
+void DataSettings::add_simulate(const Setting& s, const JobContext& cx) {
+  sim_where = s.origin();
+  std::string key = s.key == "seed" ? "seed" : s.key.substr(9);
+  const std::string first = split_dotted(key)[0];
+  const auto& alias = sim_alias();
+  if (key == "config")
+    sim_configs.push_back(cx.rel(cx.text_of(s)).string());
+  else if (key == "set")
+    for (const auto& a : cx.list_of(s)) sim_sets.push_back(a);
+  else if (key == "only")
+    only = cx.list_of(s);
+  else if (key == "disable")
+    for (const auto& a : cx.list_of(s)) disable.push_back(a);
+  else if (key == "fault" || key == "faults_append")
+    for (const auto& a : cx.list_of(s)) faults.push_back(a);
+  else if (key == "wheel_noise")
+    wheel_noise = cx.text_of(s);
+  else if (key == "no_earth_rotation") {
+    try {
+      earth_rotation = !s.value.as<bool>();
+    } catch (const YAML::Exception&) {
+      throw InputError(cx.who + ": " + s.origin() +
+                       ": simulate.no_earth_rotation: expected true or false");
+    }
+  } else if (key == "no_ideal" || key == "out" || key == "force" || key == "quiet")
+    throw InputError(cx.who + ": " + s.origin() + ": simulate." + key +
+                     " is an output choice of `wheelins simulate`, not a setting of the data");
+  else {
+    if (const auto a = alias.find(first); a != alias.end() && key == first) key = a->second;
+    sim_origin[key] = s.origin();
+    if (key == "scenario" || key == "speed_file") {
+      const std::string p = cx.text_of(s);
+      sim_tree.set(split_dotted(key), 0,
+                   YAML::Node(key == "scenario" && p == "default" ? p : cx.rel(p).string()));
+    } else {
+      sim_tree.set(split_dotted(key), 0, s.value);
+    }
+  }
+}
+
+/// The simulator settings as text: equal text, the same data.
+std::string DataSettings::memo_key() const {
+  std::string key = sim_tree.text() + "\n--";
+  for (const auto* list : {&sim_configs, &sim_sets, &faults, &disable}) {
+    key += "--\n";
+    for (const auto& x : *list) key += x + "\n";
+  }
+  key += "--" + wheel_noise.value_or("-") + "\n";
+  if (only)
+    for (const auto& x : *only) key += "only " + x + "\n";
+  if (earth_rotation) key += *earth_rotation ? "earth\n" : "no earth\n";
+  return key;
+}
+
+/// The settings of the data; the others (run settings and manifest edits) go to `later`, in
+/// order.
+DataSettings read_data_settings(const std::vector<Setting>& settings, const JobContext& cx,
+                                std::vector<const Setting*>& later) {
+  DataSettings data;
+  for (const Setting& s : settings) {
+    if (s.key == "dataset") {
+      data.dataset = cx.rel(cx.text_of(s));
+      if (fs::is_directory(*data.dataset)) *data.dataset /= "manifest.yaml";
+      data.dataset_where = s.origin();
+      continue;
+    }
+    if (s.key == "seed" || s.key.rfind("simulate.", 0) == 0) {
+      data.add_simulate(s, cx);
+      continue;
+    }
+    later.push_back(&s);  // run settings and manifest edits may refer to the data's settings
+  }
+  return data;
+}
+
+/// The simulator configuration of `data`; messages name `where`.
+sim::SimConfig sim_config(const DataSettings& data, const std::string& where) {
+  sim::SimConfig c;
+  c.write_ideal = false;  // the cache keeps the data a filter reads, not the error-free streams
+  for (const auto& f : data.sim_configs) {
+    YAML::Node node;
+    try {
+      node = load_yaml_file(f, "simulator settings");
+    } catch (const InputError& e) {
+      throw InputError(where + ": " + e.what());
+    }
+    c.apply_yaml(node, where + " ('" + f + "')");
+  }
+  if (!data.sim_tree.kids.empty()) {
+    // A message about a key names the study's setting that gave it (its key and line).
+    const auto origin = [&](const std::string& k) {
+      for (std::string p = k;; p = p.substr(0, p.rfind('.'))) {
+        if (const auto it = data.sim_origin.find(p); it != data.sim_origin.end())
+          return " (set by " + it->second + ")";
+        if (p.find('.') == std::string::npos) return std::string();
+      }
+    };
+    c.apply_yaml(parse_yaml(data.sim_tree.text(), where, "simulator settings"), where, origin);
+  }
+  try {
+    for (const auto& a : data.sim_sets) c.apply_setting(a);
+    if (data.wheel_noise) {
+      c.apply_setting("errors.wheel_accel_noise_m_s_sqrt_h=" + *data.wheel_noise);
+      c.effects.insert("wheel_noise");
+    }
+    for (const auto& f : data.faults) c.faults.push_back(sim::parse_fault_spec(f));
+    if (data.only) c.only(*data.only);
+    c.disable(data.disable);
+    if (data.earth_rotation) c.earth_rotation = *data.earth_rotation;
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+  return c;
+}
+
+/// The data simulated by `c`: their canonical text and cache directory.
+DatasetSpec simulated_data(sim::SimConfig c) {
+  DatasetSpec d;
+  d.canonical = "wheelins study dataset 1\n" + c.to_yaml();
+  if (c.scenario != "default")
+    d.canonical += "scenario_file: " + fnv_of_file(c.scenario, "scenario file") + "\n";
+  if (c.speed_file)
+    d.canonical += "speed_file: " + fnv_of_file(*c.speed_file, "speed file") + "\n";
+  d.cache_name = slug(c.vehicle.preset + "-" + c.profile + "-seed" + std::to_string(c.seed)) +
+                 "-" + hash_text(d.canonical);
+  d.sim = std::move(c);
+  return d;
+}
+
+/// A reference "${KEY}" to a setting of the job's data (`values`: dotted key -> value, when
+/// simulated).
+struct DataRefs {
+  const JobContext& cx;
+  const DatasetSpec& data;
+  const std::map<std::string, std::string>* values;
+
+  std::string operator()(const std::string& ref, const std::string& where) const {
+    std::string key = ref == "seed" ? "simulate.seed" : ref;
+    if (key.rfind("simulate.", 0) != 0)
+      throw InputError(cx.who + ": " + where + ": ${" + ref +
+                       "}: only the data's settings can be referred to (simulate.KEY or seed)");
+    if (!data.sim)
+      throw InputError(cx.who + ": " + where + ": ${" + ref +
+                       "}: the job's data are not simulated");
+    key = key.substr(9);
+    if (const auto a = sim_alias().find(key); a != sim_alias().end()) key = a->second;
+    if (key == "wheel_noise") key = "errors.wheel_accel_noise_m_s_sqrt_h";
+    const auto it = values->find(key);
+    if (it == values->end())
+      throw InputError(cx.who + ": " + where + ": ${" + ref +
+                       "}: no such simulator setting (a single value)");
+    return it->second;
+  }
+};
+
+/// A job's run settings, manifest edits, `configuration` and `chip`.
+struct RunSettings {
+  Tree tree;
+  std::string edits;
+  std::optional<std::string> configuration, chip;
+};
+
+/// The run settings and manifest edits of `later`, with references to the data's settings
+/// resolved by `lookup`.
+RunSettings read_run_settings(
+    const std::vector<const Setting*>& later,
+    const std::function<std::string(const std::string&, const std::string&)>& lookup,
+    const JobContext& cx) {
+  RunSettings run;
+  for (const Setting* sp : later) {
+    const Setting& s0 = *sp;
+    const Setting s{s0.key, substitute(s0.value, lookup, s0.where), s0.where, s0.line};
+    if (s.key.rfind("run.", 0) == 0) {
+      const std::string key = s.key.substr(4);
+      if (key == "dataset")
+        throw InputError(cx.who + ": " + s.origin() +
+                         ": run.dataset: give the data with `dataset` or `simulate`");
+      run.tree.set(split_dotted(key), 0, s.value);
+    } else if (s.key.rfind("manifest.", 0) == 0) {
+      run.edits += "- " + yaml_key(s.key.substr(9)) + ": " + flow_yaml(s.value) + "\n";
+    } else if (s.key == "configuration") {
+      run.configuration = cx.text_of(s);
+    } else if (s.key == "chip") {
+      run.chip = cx.text_of(s);
+    } else if (s.key == "chips" || s.key == "modules") {
+      YAML::Node seq(YAML::NodeType::Sequence);
+      for (const auto& c : cx.list_of(s)) seq.push_back(c);
+      run.tree.set({s.key}, 0, seq);
+    } else {
+      throw InputError(cx.who + ": " + s.origin() + ": unknown setting '" + s.key + "'");
+    }
+  }
+  if (const Tree* out = run.tree.find("output")) {
+    if (out->leaf)
+      throw InputError(cx.who + ": run.output: expected a map (only output.interval_s applies)");
+    for (const auto& kv : out->kids)
+      if (kv.first != "interval_s")
+        throw InputError(cx.who + ": run.output." + kv.first +
+                         ": a study writes no trajectories (only output.interval_s applies)");
+  }
+  return run;
+}
+
+/// The run configuration's name (`configuration`, else run.configuration; empty: none), with
+/// it and `chip` put into the run settings.
+std::string apply_configuration(RunSettings& run, const JobContext& cx) {
+  std::string cfg = run.configuration.value_or("");
+  if (cfg.empty()) {
+    if (const Tree* t = run.tree.find("configuration"); t && t->leaf)
+      cfg = cx.text_of(
+          {"run.configuration", parse_yaml(*t->leaf, cx.who, "setting"), "run.configuration"});
+  }
+  if (cfg == "centralized") {
+    run.tree.set({"configuration"}, 0, YAML::Node("triple"));
+    run.tree.set({"fusion", "centralized"}, 0, YAML::Node(true));
+  } else if (run.configuration) {
+    run.tree.set({"configuration"}, 0, YAML::Node(cfg));
+  }
+  if (run.chip) {
+    YAML::Node seq(YAML::NodeType::Sequence);
+    for (std::size_t i = 0; i < imu_count(cfg.empty() ? "single" : cfg); ++i)
+      seq.push_back(*run.chip);
+    run.tree.set({"chips"}, 0, seq);
+  }
+  return cfg;
+}
+
 }  // namespace
 
 Job Study::job(std::size_t k) const {
@@ -236,159 +507,33 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
   j.choice = choice;
   for (std::size_t i = 0; i < axes_.size(); ++i)
     j.labels.push_back(axes_[i].values[choice[i]].label);
-  const std::string who = "'" + file_.string() + "': job " + std::to_string(k);
-  auto rel = [&](const std::string& p) {
-    return (fs::path(p).is_absolute() ? fs::path(p) : fs::absolute(dir_ / p)).lexically_normal();
-  };
-  auto text_of = [&](const Setting& s) {
-    if (!s.value.IsScalar() || s.value.Scalar().empty())
-      throw InputError(who + ": " + s.origin() + ": " + s.key + ": expected a text value");
-    return s.value.Scalar();
-  };
-  auto list_of = [&](const Setting& s) {
-    std::vector<std::string> out;
-    if (s.value.IsScalar()) {
-      std::stringstream ss(s.value.Scalar());
-      for (std::string item; std::getline(ss, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    } else if (s.value.IsSequence()) {
-      for (const auto& x : s.value) out.push_back(x.as<std::string>());
-    } else {
-      throw InputError(who + ": " + s.origin() + ": " + s.key + ": expected a list");
-    }
-    return out;
-  };
-
-  std::optional<fs::path> dataset;
-  std::string dataset_where, sim_where;
-  Tree sim_tree, run_tree;
-  std::vector<std::string> sim_configs, sim_sets, faults, disable;
-  std::map<std::string, std::string> sim_origin;  // dotted simulator key -> where it was set
-  std::optional<std::vector<std::string>> only;
-  std::optional<std::string> wheel_noise;
-  std::optional<bool> earth_rotation;
-  std::string edits;
-  std::optional<std::string> configuration, chip;
+  JobContext cx;
+  cx.who = "'" + file_.string() + "': job " + std::to_string(k);
+  cx.dir = dir_;
   std::vector<const Setting*> later;
-  for (const Setting& s : settings) {
-    if (s.key == "dataset") {
-      dataset = rel(text_of(s));
-      if (fs::is_directory(*dataset)) *dataset /= "manifest.yaml";
-      dataset_where = s.origin();
-      continue;
-    }
-    if (s.key == "seed" || s.key.rfind("simulate.", 0) == 0) {
-      sim_where = s.origin();
-      std::string key = s.key == "seed" ? "seed" : s.key.substr(9);
-      const std::string first = split_dotted(key)[0];
-      const auto& alias = sim_alias();
-      if (key == "config")
-        sim_configs.push_back(rel(text_of(s)).string());
-      else if (key == "set")
-        for (const auto& a : list_of(s)) sim_sets.push_back(a);
-      else if (key == "only")
-        only = list_of(s);
-      else if (key == "disable")
-        for (const auto& a : list_of(s)) disable.push_back(a);
-      else if (key == "fault" || key == "faults_append")
-        for (const auto& a : list_of(s)) faults.push_back(a);
-      else if (key == "wheel_noise")
-        wheel_noise = text_of(s);
-      else if (key == "no_earth_rotation") {
-        try {
-          earth_rotation = !s.value.as<bool>();
-        } catch (const YAML::Exception&) {
-          throw InputError(who + ": " + s.origin() +
-                           ": simulate.no_earth_rotation: expected true or false");
-        }
-      } else if (key == "no_ideal" || key == "out" || key == "force" || key == "quiet")
-        throw InputError(who + ": " + s.origin() + ": simulate." + key +
-                         " is an output choice of `wheelins simulate`, not a setting of the data");
-      else {
-        if (const auto a = alias.find(first); a != alias.end() && key == first) key = a->second;
-        sim_origin[key] = s.origin();
-        if (key == "scenario" || key == "speed_file") {
-          const std::string p = text_of(s);
-          sim_tree.set(split_dotted(key), 0,
-                       YAML::Node(key == "scenario" && p == "default" ? p : rel(p).string()));
-        } else {
-          sim_tree.set(split_dotted(key), 0, s.value);
-        }
-      }
-      continue;
-    }
-    later.push_back(&s);  // run settings and manifest edits may refer to the data's settings
-  }
+  const DataSettings data = read_data_settings(settings, cx, later);
   // The data.
   DatasetSpec& d = j.dataset;
   const std::map<std::string, std::string>* sim_values = nullptr;  // dotted key -> value
-  if (dataset && !sim_where.empty())
-    throw InputError(who + ": both a dataset (" + dataset_where + ") and simulator settings (" +
-                     sim_where + "): a job navigates one or the other");
-  if (dataset) {
-    d.manifest = *dataset;
-    d.canonical = "manifest: " + dataset->string() +
-                  "\nmanifest_text: " + fnv_of_file(*dataset, "manifest") + "\n";
-  } else if (!sim_where.empty() || !sim_configs.empty()) {
+  if (data.dataset && !data.sim_where.empty())
+    throw InputError(cx.who + ": both a dataset (" + data.dataset_where +
+                     ") and simulator settings (" + data.sim_where +
+                     "): a job navigates one or the other");
+  if (data.dataset) {
+    d.manifest = *data.dataset;
+    d.canonical = "manifest: " + data.dataset->string() +
+                  "\nmanifest_text: " + fnv_of_file(*data.dataset, "manifest") + "\n";
+  } else if (!data.sim_where.empty() || !data.sim_configs.empty()) {
     // The same simulator settings give the same data: resolved once per study (a sweep has
     // many jobs per dataset).
-    std::string memo_key = sim_tree.text() + "\n--";
-    for (const auto* list : {&sim_configs, &sim_sets, &faults, &disable}) {
-      memo_key += "--\n";
-      for (const auto& x : *list) memo_key += x + "\n";
-    }
-    memo_key += "--" + wheel_noise.value_or("-") + "\n";
-    if (only)
-      for (const auto& x : *only) memo_key += "only " + x + "\n";
-    if (earth_rotation) memo_key += *earth_rotation ? "earth\n" : "no earth\n";
+    const std::string memo_key = data.memo_key();
     auto& memo = *sim_memo_;
     if (const auto it = memo.find(memo_key); it != memo.end()) {
       d = it->second.data;
       sim_values = &it->second.values;
     } else {
-      sim::SimConfig c;
-      c.write_ideal = false;  // the cache keeps the data a filter reads, not the error-free streams
-      const std::string where = who + ": simulator settings";
-      for (const auto& f : sim_configs) {
-        YAML::Node node;
-        try {
-          node = load_yaml_file(f, "simulator settings");
-        } catch (const InputError& e) {
-          throw InputError(where + ": " + e.what());
-        }
-        c.apply_yaml(node, where + " ('" + f + "')");
-      }
-      if (!sim_tree.kids.empty()) {
-        // A message about a key names the study's setting that gave it (its key and line).
-        const auto origin = [&](const std::string& k) {
-          for (std::string p = k;; p = p.substr(0, p.rfind('.'))) {
-            if (const auto it = sim_origin.find(p); it != sim_origin.end()) return " (set by " + it->second + ")";
-            if (p.find('.') == std::string::npos) return std::string();
-          }
-        };
-        c.apply_yaml(parse_yaml(sim_tree.text(), where, "simulator settings"), where, origin);
-      }
-      try {
-        for (const auto& a : sim_sets) c.apply_setting(a);
-        if (wheel_noise) {
-          c.apply_setting("errors.wheel_accel_noise_m_s_sqrt_h=" + *wheel_noise);
-          c.effects.insert("wheel_noise");
-        }
-        for (const auto& f : faults) c.faults.push_back(sim::parse_fault_spec(f));
-        if (only) c.only(*only);
-        c.disable(disable);
-        if (earth_rotation) c.earth_rotation = *earth_rotation;
-      } catch (const InputError& e) {
-        throw InputError(where + ": " + e.what());
-      }
-      d.canonical = "wheelins study dataset 1\n" + c.to_yaml();
-      if (c.scenario != "default")
-        d.canonical += "scenario_file: " + fnv_of_file(c.scenario, "scenario file") + "\n";
-      if (c.speed_file)
-        d.canonical += "speed_file: " + fnv_of_file(*c.speed_file, "speed file") + "\n";
-      d.cache_name = slug(c.vehicle.preset + "-" + c.profile + "-seed" + std::to_string(c.seed)) +
-                     "-" + hash_text(d.canonical);
-      d.sim = std::move(c);
+      const std::string where = cx.who + ": simulator settings";
+      d = simulated_data(sim_config(data, where));
       if (memo.size() > 100000) memo.clear();
       SimMemo& m = memo[memo_key];
       m.data = d;
@@ -396,89 +541,28 @@ Job Study::resolve(std::size_t k, const std::vector<std::size_t>& choice,
       sim_values = &m.values;
     }
   } else {
-    throw InputError(who +
+    throw InputError(cx.who +
                      ": no data: give `dataset: MANIFEST` or simulator settings (`simulate:`)");
   }
   // Run settings and manifest edits, with references to the data's settings resolved.
-  auto lookup = [&](const std::string& ref, const std::string& where) -> std::string {
-    std::string key = ref == "seed" ? "simulate.seed" : ref;
-    if (key.rfind("simulate.", 0) != 0)
-      throw InputError(who + ": " + where + ": ${" + ref +
-                       "}: only the data's settings can be referred to (simulate.KEY or seed)");
-    if (!d.sim)
-      throw InputError(who + ": " + where + ": ${" + ref + "}: the job's data are not simulated");
-    key = key.substr(9);
-    if (const auto a = sim_alias().find(key); a != sim_alias().end()) key = a->second;
-    if (key == "wheel_noise") key = "errors.wheel_accel_noise_m_s_sqrt_h";
-    const auto it = sim_values->find(key);
-    if (it == sim_values->end())
-      throw InputError(who + ": " + where + ": ${" + ref +
-                       "}: no such simulator setting (a single value)");
-    return it->second;
-  };
-  for (const Setting* sp : later) {
-    const Setting& s0 = *sp;
-    const Setting s{s0.key, substitute(s0.value, lookup, s0.where), s0.where, s0.line};
-    if (s.key.rfind("run.", 0) == 0) {
-      const std::string key = s.key.substr(4);
-      if (key == "dataset")
-        throw InputError(who + ": " + s.origin() +
-                         ": run.dataset: give the data with `dataset` or `simulate`");
-      run_tree.set(split_dotted(key), 0, s.value);
-    } else if (s.key.rfind("manifest.", 0) == 0) {
-      edits += "- " + yaml_key(s.key.substr(9)) + ": " + flow_yaml(s.value) + "\n";
-    } else if (s.key == "configuration") {
-      configuration = text_of(s);
-    } else if (s.key == "chip") {
-      chip = text_of(s);
-    } else if (s.key == "chips" || s.key == "modules") {
-      YAML::Node seq(YAML::NodeType::Sequence);
-      for (const auto& c : list_of(s)) seq.push_back(c);
-      run_tree.set({s.key}, 0, seq);
-    } else {
-      throw InputError(who + ": " + s.origin() + ": unknown setting '" + s.key + "'");
-    }
-  }
-  if (const Tree* out = run_tree.find("output")) {
-    if (out->leaf)
-      throw InputError(who + ": run.output: expected a map (only output.interval_s applies)");
-    for (const auto& kv : out->kids)
-      if (kv.first != "interval_s")
-        throw InputError(who + ": run.output." + kv.first +
-                         ": a study writes no trajectories (only output.interval_s applies)");
-  }
+  RunSettings run = read_run_settings(later, DataRefs{cx, d, sim_values}, cx);
 
-  d.manifest_edits = edits;
+  d.manifest_edits = run.edits;
   // Edits of a manifest that is not ours go into the cache (the data stay where they are).
-  if (d.manifest && !edits.empty())
+  if (d.manifest && !run.edits.empty())
     d.cache_name = "edited-" + slug(d.manifest->parent_path().filename().string()) + "-" +
-                   hash_text(d.canonical + edits);
+                   hash_text(d.canonical + run.edits);
 
   // The run configuration.
-  std::string cfg = configuration.value_or("");
-  if (cfg.empty()) {
-    if (const Tree* t = run_tree.find("configuration"); t && t->leaf)
-      cfg = text_of({"run.configuration", parse_yaml(*t->leaf, who, "setting"), "run.configuration"});
-  }
-  if (cfg == "centralized") {
-    run_tree.set({"configuration"}, 0, YAML::Node("triple"));
-    run_tree.set({"fusion", "centralized"}, 0, YAML::Node(true));
-  } else if (configuration) {
-    run_tree.set({"configuration"}, 0, YAML::Node(cfg));
-  }
-  if (chip) {
-    YAML::Node seq(YAML::NodeType::Sequence);
-    for (std::size_t i = 0; i < imu_count(cfg.empty() ? "single" : cfg); ++i) seq.push_back(*chip);
-    run_tree.set({"chips"}, 0, seq);
-  }
-  if (!run_tree.has({"output", "interval_s"}))
-    run_tree.set({"output", "interval_s"}, 0, YAML::Node("0.05"));
-  j.run_yaml = run_tree.text();
+  const std::string cfg = apply_configuration(run, cx);
+  if (!run.tree.has({"output", "interval_s"}))
+    run.tree.set({"output", "interval_s"}, 0, YAML::Node("0.05"));
+  j.run_yaml = run.tree.text();
   j.configuration = cfg.empty() ? "single" : cfg;
   for (std::size_t i = 0; i < axes_.size(); ++i)
     if (axes_[i].role == AxisRole::kConfiguration) j.configuration = j.labels[i];
-  j.canonical = d.canonical + (edits.empty() ? "" : "--- manifest edits\n" + edits) + "--- run\n" +
-                j.run_yaml;
+  j.canonical = d.canonical + (run.edits.empty() ? "" : "--- manifest edits\n" + run.edits) +
+                "--- run\n" + j.run_yaml;
   j.key = hash_text(j.canonical);
   return j;
 }
