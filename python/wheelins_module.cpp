@@ -394,38 +394,9 @@ class StreamNavigator {
                   std::optional<bool> fault_handling, std::optional<double> duration,
                   std::optional<double> output_interval, std::optional<double> covariance_interval,
                   const std::string& yaw_scale_factors, const std::string& calibration,
-                  double calibration_warmup) {
-    // It sees each sample once. "manifest" (the default): the manifest's geometry as it is
-    // (a calibrated manifest comes from `wheelins calibrate`). "estimate": the installation
-    // geometry estimated from the first `calibration_warmup` seconds after the static period,
-    // whose samples are kept and navigated when it ends (docs/python.md).
-    const RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
-                                           position_constraint, fault_handling, duration, output_interval,
-                                           covariance_interval, yaw_scale_factors,
-                                           calibration.empty() ? "manifest" : calibration);
-    const WarningSink warn = stderr_sink();
-    RunRequest req = make_run_request(run_config_with(s, warn), warn);
-    req.output_dir.clear();
-    req.on_record = [this](const TrajectoryRecord& r) { records_.push_back(r); };
-    run_ = std::make_unique<PushSession>(std::move(req), calibration_warmup);
-  }
+                  double calibration_warmup);
 
-  int index_of(const py::object& module) const {
-    const std::vector<std::string>& names = run_->request().modules;
-    if (py::isinstance<py::int_>(module)) {
-      const int i = module.cast<int>();
-      if (i < 0 || i >= static_cast<int>(names.size()))
-        throw InputError("module index " + std::to_string(i) + " out of range (0.." +
-                         std::to_string(names.size() - 1) + ")");
-      return i;
-    }
-    const std::string name = module.cast<std::string>();
-    for (std::size_t i = 0; i < names.size(); ++i)
-      if (names[i] == name) return static_cast<int>(i);
-    std::string list;
-    for (const auto& m : names) list += (list.empty() ? "" : ", ") + m;
-    throw InputError("module '" + name + "' is not navigated (modules: " + list + ")");
-  }
+  int index_of(const py::object& module) const;
 
   /// One record of module `module` as its file holds it; false once the duration is reached.
   bool push(const py::object& module, double t, const std::array<double, 3>& gyro, const std::array<double, 3>& accel) {
@@ -440,31 +411,8 @@ class StreamNavigator {
     if (!run_->finished()) run_->finish();
   }
 
-  py::object state() const {
-    if (!navigating()) return py::none();
-    const TrajectoryRecord r = nav().vehicle_record();
-    const auto names = trajectory_csv_header();
-    std::vector<double> v(names.size());
-    trajectory_csv_values(r, v.data());
-    py::dict d;
-    for (std::size_t k = 0; k < names.size(); ++k) d[py::str(names[k])] = v[k];
-    return d;
-  }
-
-  py::array_t<double> covariance(const py::object& module) const {
-    const int i = index_of(module);
-    if (run_->in_warmup()) throw InputError("no covariance during the calibration warm-up (it ends at t = " +
-                                            io_detail::format_double(run_->warmup_end()) + " s)");
-    if (!nav().navigating()) throw InputError("no covariance before navigation starts (the static period)");
-    if (run_->request().nav.fusion.centralized)
-      throw InputError("the centralized filter keeps one joint covariance; its per-module blocks are not "
-                       "exposed (the state's *_std_* entries are the vehicle's sigmas)");
-    const Mat21& P = nav().subsystem(i).ekf().covariance();
-    py::array_t<double> a({21, 21});
-    for (int r = 0; r < 21; ++r)
-      for (int c = 0; c < 21; ++c) a.mutable_at(r, c) = P(r, c);
-    return a;
-  }
+  py::object state() const;
+  py::array_t<double> covariance(const py::object& module) const;
 
   const std::vector<std::string>& modules() const { return run_->request().modules; }
   bool navigating() const { return nav().navigating(); }
@@ -500,11 +448,75 @@ class StreamNavigator {
   std::unique_ptr<PushSession> run_;
 };
 
-}  // namespace
+StreamNavigator::StreamNavigator(const py::object& manifest, const std::string& configuration,
+                                 const std::vector<std::string>& chips, const std::vector<std::string>& modules,
+                                 const py::object& config, const std::string& speed, std::optional<bool> centralized,
+                                 std::optional<bool> position_constraint, std::optional<bool> fault_handling,
+                                 std::optional<double> duration, std::optional<double> output_interval,
+                                 std::optional<double> covariance_interval, const std::string& yaw_scale_factors,
+                                 const std::string& calibration, double calibration_warmup) {
+  // It sees each sample once. "manifest" (the default): the manifest's geometry as it is
+  // (a calibrated manifest comes from `wheelins calibrate`). "estimate": the installation
+  // geometry estimated from the first `calibration_warmup` seconds after the static period,
+  // whose samples are kept and navigated when it ends (docs/python.md).
+  const RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
+                                         position_constraint, fault_handling, duration, output_interval,
+                                         covariance_interval, yaw_scale_factors,
+                                         calibration.empty() ? "manifest" : calibration);
+  const WarningSink warn = stderr_sink();
+  RunRequest req = make_run_request(run_config_with(s, warn), warn);
+  req.output_dir.clear();
+  req.on_record = [this](const TrajectoryRecord& r) { records_.push_back(r); };
+  run_ = std::make_unique<PushSession>(std::move(req), calibration_warmup);
+}
 
-PYBIND11_MODULE(_core, m) {
-  m.doc() = "wheelins native core (use the wheelins package)";
-  // InputError as wheelins.InputError (a ValueError), its message in Python's words.
+int StreamNavigator::index_of(const py::object& module) const {
+  const std::vector<std::string>& names = run_->request().modules;
+  if (py::isinstance<py::int_>(module)) {
+    const int i = module.cast<int>();
+    if (i < 0 || i >= static_cast<int>(names.size()))
+      throw InputError("module index " + std::to_string(i) + " out of range (0.." +
+                       std::to_string(names.size() - 1) + ")");
+    return i;
+  }
+  const std::string name = module.cast<std::string>();
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<int>(i);
+  std::string list;
+  for (const auto& m : names) list += (list.empty() ? "" : ", ") + m;
+  throw InputError("module '" + name + "' is not navigated (modules: " + list + ")");
+}
+
+py::object StreamNavigator::state() const {
+  if (!navigating()) return py::none();
+  const TrajectoryRecord r = nav().vehicle_record();
+  const auto names = trajectory_csv_header();
+  std::vector<double> v(names.size());
+  trajectory_csv_values(r, v.data());
+  py::dict d;
+  for (std::size_t k = 0; k < names.size(); ++k) d[py::str(names[k])] = v[k];
+  return d;
+}
+
+py::array_t<double> StreamNavigator::covariance(const py::object& module) const {
+  const int i = index_of(module);
+  if (run_->in_warmup()) throw InputError("no covariance during the calibration warm-up (it ends at t = " +
+                                          io_detail::format_double(run_->warmup_end()) + " s)");
+  if (!nav().navigating()) throw InputError("no covariance before navigation starts (the static period)");
+  if (run_->request().nav.fusion.centralized)
+    throw InputError("the centralized filter keeps one joint covariance; its per-module blocks are not "
+                     "exposed (the state's *_std_* entries are the vehicle's sigmas)");
+  const Mat21& P = nav().subsystem(i).ekf().covariance();
+  py::array_t<double> a({21, 21});
+  for (int r = 0; r < 21; ++r)
+    for (int c = 0; c < 21; ++c) a.mutable_at(r, c) = P(r, c);
+  return a;
+}
+
+// ------------------------------------------------------------------------ bindings
+
+/// InputError as wheelins.InputError (a ValueError), its message in Python's words.
+void bind_errors(py::module_& m) {
   static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
@@ -515,9 +527,14 @@ PYBIND11_MODULE(_core, m) {
       PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
     }
   });
+}
+
+void bind_formats(py::module_& m) {
   m.def("yaml_dict", &yaml_dict, py::arg("text"), "A YAML report's text as dicts and lists");
   m.def("csv_columns", &trajectory_csv_header, "The trajectory CSV's column names, in order");
+}
 
+void bind_run_output(py::module_& m) {
   py::class_<RunOutput>(m, "RunOutput")
       .def_readonly("modules", &RunOutput::modules)
       .def_readonly("metrics_json", &RunOutput::metrics_json)
@@ -546,7 +563,10 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("wall_seconds", &RunOutput::wall_seconds)
       .def_property_readonly("stats", [](const RunOutput& r) { return stats_dict(r.stats); })
       .def_property_readonly("table", [](const RunOutput& r) { return table(r.records); });
+}
 
+/// run, evaluate, read_truth and simulate (after RunOutput, which run() returns).
+void bind_functions(py::module_& m) {
   m.def("run", &run, py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
         py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("out") = py::none(),
         py::arg("formats") = std::vector<std::string>{}, py::arg("speed") = "", py::arg("centralized") = py::none(),
@@ -561,7 +581,9 @@ PYBIND11_MODULE(_core, m) {
   m.def("read_truth", &read_truth_table, py::arg("truth"), py::arg("origin") = py::none());
   m.def("simulate", &simulate, py::arg("out"), py::arg("settings"), py::arg("force") = false, py::arg("progress") = false,
         py::arg("write_ideal") = true);
+}
 
+void bind_navigator(py::module_& m) {
   py::class_<StreamNavigator>(m, "Navigator")
       .def(py::init<const py::object&, const std::string&, const std::vector<std::string>&, const std::vector<std::string>&,
                     const py::object&, const std::string&, std::optional<bool>, std::optional<bool>, std::optional<bool>,
@@ -587,4 +609,15 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("noise_yaml", &StreamNavigator::noise_yaml)
       .def_property_readonly("calibration", &StreamNavigator::calibration)
       .def_property_readonly("calibration_report", &StreamNavigator::calibration_report);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "wheelins native core (use the wheelins package)";
+  bind_errors(m);
+  bind_formats(m);
+  bind_run_output(m);
+  bind_functions(m);
+  bind_navigator(m);
 }
