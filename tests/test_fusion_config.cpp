@@ -2,9 +2,13 @@
 // errors naming the file, key and line, unknown keys are warnings naming the closest key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include "dataset_test_util.hpp"
 #include "io_test_util.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run_config.hpp"
+#include "wheelins/run/run_options.hpp"
 
 using namespace wheelins;
 using iotest::error_of;
@@ -224,4 +228,64 @@ TEST(FusionNavigator, RefusesOptionsOutOfRange) {
   o.output_interval = -0.1;
   EXPECT_NE(err(o).find("output interval"), std::string::npos) << err(o);
   EXPECT_NO_THROW(Navigator(m, {"left-C1"}, NavigatorOptions{}, [](int, const TrajectoryRecord&) {}));
+}
+
+// The settings are declared once (run/run_options.hpp); the documentation's table of them is
+// that declaration, printed.
+TEST(RunOptions, TheDocumentationsTableIsTheDeclarations) {
+  const std::string doc =
+      iotest::read_text_file(std::filesystem::path(WHEELINS_SOURCE_DIR) / "docs" / "run-config.md");
+  const std::string begin = "<!-- settings: from src/wheelins/run/run_options.hpp -->\n",
+                    end = "<!-- end of the settings -->";
+  const std::size_t a = doc.find(begin), b = doc.find(end);
+  ASSERT_NE(a, std::string::npos) << "docs/run-config.md lacks the line " << begin;
+  ASSERT_NE(b, std::string::npos) << "docs/run-config.md lacks the line " << end;
+  // The table, then a blank line before the closing comment.
+  EXPECT_EQ(doc.substr(a + begin.size(), b - a - begin.size()), run_options_markdown() + "\n")
+      << "docs/run-config.md's table of settings is not the declarations; as declared it reads:\n"
+      << run_options_markdown();
+}
+
+// Every declared key is read: a file giving each of them is accepted without a warning.
+TEST(RunOptions, EveryDeclaredKeyIsKnownToTheReader) {
+  const std::string table = run_options_markdown();
+  std::vector<std::string> keys;
+  for (std::size_t at = table.find("\n| `"); at != std::string::npos; at = table.find("\n| `", at + 1))
+    keys.push_back(table.substr(at + 4, table.find('`', at + 4) - at - 4));
+  EXPECT_GT(keys.size(), 60u);
+  EXPECT_NE(std::find(keys.begin(), keys.end(), "fusion.position_std_m"), keys.end());
+  EXPECT_NE(std::find(keys.begin(), keys.end(), "filter.initial_std.heading_deg"), keys.end());
+  // The reader warns about an unknown key: a made-up one in each section is warned about,
+  // none of the declared ones.
+  ScratchDir dir;
+  write_text(dir / "run.yaml",
+             "dataset: m.yaml\nfilter: {initial_std: {heading_deg: 0.2, hedding_deg: 1}, speed_windw_s: 1}\n"
+             "fusion: {position_std_m: 0.3}\nfaults: {window: 3, max_failed: 2}\n");
+  std::vector<std::string> warnings;
+  const RunConfig c = load_run_config(dir / "run.yaml", [&](const std::string& w) { warnings.push_back(w); });
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("speed_window_s"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("heading_deg"), std::string::npos) << warnings[1];
+  EXPECT_DOUBLE_EQ(c.nav.fusion.position_std, 0.3);
+  EXPECT_DOUBLE_EQ(c.nav.wheel.init.heading, 0.2 * kDeg);
+  EXPECT_DOUBLE_EQ(c.nav.body.init.heading, 0.2 * kDeg);
+  EXPECT_EQ(c.nav.faults.window, 3);
+}
+
+// The command-line option a declaration names is one of `wheelins run`'s.
+TEST(RunOptions, TheDeclaredCommandLineOptionsExist) {
+  ScratchDir dir;
+  const dstest::CmdResult help = dstest::wheelins_cli("run --help", dir / "");
+  ASSERT_EQ(help.code, 0) << help.err;
+  const std::string table = run_options_markdown();
+  int named = 0;
+  for (std::size_t row = table.find("\n| `"); row != std::string::npos; row = table.find("\n| `", row + 1)) {
+    const std::size_t cell = table.find(" | ", row + 3) + 3;
+    if (table.compare(cell, 1, "`") != 0) continue;
+    const std::string flag = table.substr(cell + 1, table.find('`', cell + 1) - cell - 1);
+    const bool listed = help.out.find(flag + " ") != std::string::npos || help.out.find(flag + ",") != std::string::npos;
+    EXPECT_TRUE(listed) << flag << " is not an option of wheelins run";
+    ++named;
+  }
+  EXPECT_GT(named, 15);
 }
