@@ -16,6 +16,10 @@ using Setup = std::function<Runner(CLI::App& sub)>;
 /// "a,b,,c" -> {a, b, c}: a comma-separated list, empty items dropped.
 std::vector<std::string> split_list(const std::string& text);
 
+/// `--set KEY=VALUE` (repeatable): any setting of the run configuration (docs/run-config.md),
+/// into RunOverrides::settings.
+void add_settings_option(CLI::App& sub, std::vector<std::string>& settings);
+
 /// Called from a static object in each cmd_*.cpp; `order` sorts the --help listing.
 bool register_command(int order, const std::string& name, const std::string& description,
                       Setup setup);

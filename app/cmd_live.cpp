@@ -37,6 +37,7 @@ struct LiveArgs {
   std::optional<int> udp_port;  // none: standard input
   std::optional<double> duration;
   bool centralized = false, no_faults = false, fixed_noise = false, force = false, full_rate = false;
+  std::vector<std::string> settings;  ///< --set KEY=VALUE
 };
 
 double now_seconds() {
@@ -178,6 +179,7 @@ RunRequest live_request(const LiveArgs& a, const WarningSink& warn) {
   o.duration = a.duration;
   o.overwrite = a.force;
   o.full_rate = a.full_rate;
+  o.settings = a.settings;
   RunRequest req = make_run_request(run_config_with(o, warn), warn);
   if (a.out.empty()) req.output_dir.clear();  // the states go out; files only when asked for
   return req;
@@ -293,6 +295,7 @@ const bool registered = cli::register_command(
       sub.add_flag("--fixed-noise", a->fixed_noise, "Hold the noise figures fixed");
       sub.add_flag("--full-rate", a->full_rate, "The trajectory files at every record");
       sub.add_flag("--force,-f", a->force, "Overwrite existing results in --out");
+      cli::add_settings_option(sub, a->settings);
       return [a]() { return live(*a); };
     });
 }  // namespace

@@ -46,6 +46,7 @@ struct RunArgs {
   bool subsystems = false;
   std::optional<double> duration, output_interval, covariance_interval, align_start;
   std::string antenna;
+  std::vector<std::string> settings;  ///< --set KEY=VALUE, any key of docs/run-config.md
 };
 
 /// A command-line number in its range [lo, hi] (NaN, infinities and 1e400 fail too).
@@ -159,6 +160,7 @@ RunOverrides overrides_of(const RunArgs& a) {
   o.overwrite = a.force;
   o.full_rate = a.full_rate;
   o.subsystems = a.subsystems;
+  o.settings = a.settings;
   return o;
 }
 
@@ -266,6 +268,7 @@ const bool registered = cli::register_command(
       sub.add_option("--covariance-interval", a->covariance_interval,
                      "Covariance time update every this many seconds (F integrated in between); "
                      "0 = every IMU epoch; at most 0.5 s");
+      cli::add_settings_option(sub, a->settings);
       sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line");
       sub.add_flag("--verbose,-v", a->verbose,

@@ -28,6 +28,13 @@ bool register_command(int order, const std::string& name, const std::string& des
   registry().push_back({order, name, description, std::move(setup)});
   return true;
 }
+void add_settings_option(CLI::App& sub, std::vector<std::string>& settings) {
+  sub.add_option("--set", settings,
+                 "KEY=VALUE: any setting of the run configuration (docs/run-config.md, e.g. "
+                 "fusion.position_std_m=0.3; VALUE is YAML), over the file; repeat it for more")
+      ->allow_extra_args(false);
+}
+
 std::vector<std::string> split_list(const std::string& text) {
   std::vector<std::string> out;
   std::size_t start = 0;

@@ -289,3 +289,43 @@ TEST(RunOptions, TheDeclaredCommandLineOptionsExist) {
   }
   EXPECT_GT(named, 15);
 }
+
+// `--set KEY=VALUE` (RunOverrides::settings): any declared key, over the file, with the file's
+// checks; a mistake is an error naming the setting.
+TEST(RunOptions, SetGivesAnyDeclaredKeyOverTheFile) {
+  ScratchDir dir;
+  write_text(dir / "run.yaml", "dataset: m.yaml\nfusion: {position_std_m: 0.3, weights: covariance}\n");
+  RunOverrides o;
+  o.config = dir / "run.yaml";
+  o.settings = {"fusion.position_std_m=0.5", "filter.velocity_update_hz=4", "fusion.weights=[1, 2]",
+                "standstill.rate_std_deg_s=0.1", "faults.window=30", "output.formats=[csv]"};
+  const RunConfig c = run_config_with(o, {});
+  EXPECT_DOUBLE_EQ(c.nav.fusion.position_std, 0.5);
+  EXPECT_DOUBLE_EQ(c.nav.wheel.velocity_update_interval, 0.25);
+  EXPECT_EQ(c.nav.fusion.weights, (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(c.nav.fusion.weighting, ReferenceWeighting::kCovariance);  // from the file, not set
+  EXPECT_DOUBLE_EQ(c.nav.standstill.rate_std, 0.1 * kDeg);
+  EXPECT_EQ(c.nav.faults.window, 30);
+  ASSERT_EQ(c.formats.size(), 1u);
+  EXPECT_EQ(c.manifest, dir / "m.yaml");
+
+  auto error = [](std::vector<std::string> settings) {
+    RunConfig r;
+    return error_of([&] { apply_run_settings(settings, r); });
+  };
+  std::string e = error({"fusion.position_std=0.5"});
+  EXPECT_NE(e.find("--set: fusion.position_std: unknown key"), std::string::npos) << e;
+  EXPECT_NE(e.find("position_std_m"), std::string::npos) << e;
+  e = error({"fusion.position_std_m=500"});
+  EXPECT_NE(e.find("--set: fusion.position_std_m: must be in [0.001, 100] m"), std::string::npos) << e;
+  EXPECT_EQ(e.find("line"), std::string::npos) << e;
+  EXPECT_NE(error({"fusion.position_std_m"}).find("expected KEY=VALUE"), std::string::npos);
+  EXPECT_NE(error({"fusion.position_std_m="}).find("no value after '='"), std::string::npos);
+  EXPECT_NE(error({"fusion..position_std_m=1"}).find("an empty part"), std::string::npos);
+  EXPECT_NE(error({"fusion.position_std_m=1", "fusion.position_std_m=2"}).find("is set twice"), std::string::npos);
+  EXPECT_NE(error({"fusion=1", "fusion.position_std_m=2"}).find("as a value and as a section"), std::string::npos);
+  EXPECT_NE(error({"fusion.weights=[1, 0]"}).find("fusion.weights[1]: must be in (0, 1e6]"), std::string::npos);
+  EXPECT_NE(error({"faults.window=3", "faults.max_failed=5"}).find("faults.max_failed"), std::string::npos);
+  e = error({"fusion.speed=fast"});
+  EXPECT_NE(e.find("--set: fusion.speed: expected mean or own"), std::string::npos) << e;
+}

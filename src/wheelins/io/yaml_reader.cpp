@@ -236,21 +236,26 @@ YAML::Node load_yaml_file(const fs::path& file, const std::string& kind,
 
 YamlReader::YamlReader(const fs::path& file, WarningSink warn, std::string kind,
                        std::string directory_hint)
-    : file_(file), warn_(std::move(warn)) {
+    : file_(file), where_(io_detail::quote(file)), warn_(std::move(warn)) {
   root_ = load_yaml_file(file_, kind, directory_hint);
   if (!root_.IsDefined() || root_.IsNull()) fail("", "the " + kind + " is empty");
   require_map(root_, "");
 }
 
+YamlReader::YamlReader(YAML::Node root, std::string where, WarningSink warn, bool with_lines)
+    : where_(std::move(where)), with_lines_(with_lines), warn_(std::move(warn)), root_(std::move(root)) {
+  require_map(root_, "");
+}
+
 YamlReader::~YamlReader() {
   if (warn_ && key_warnings_ > io_detail::kMaxKeyWarnings)
-    warn_(io_detail::quote(file_) + ": " + std::to_string(key_warnings_ - io_detail::kMaxKeyWarnings) +
+    warn_(where_ + ": " + std::to_string(key_warnings_ - io_detail::kMaxKeyWarnings) +
           " more unknown keys ignored (not reported one by one)");
 }
 
 void YamlReader::fail(const std::string& key, const std::string& what, const YAML::Node* at) const {
-  std::string msg = io_detail::quote(file_) + ": " + (key.empty() ? "" : key + ": ") + what;
-  if (at && at->IsDefined() && !at->Mark().is_null())
+  std::string msg = where_ + ": " + (key.empty() ? "" : key + ": ") + what;
+  if (with_lines_ && at && at->IsDefined() && !at->Mark().is_null())
     msg += " (line " + std::to_string(at->Mark().line + 1) + ")";
   throw InputError(msg);
 }
@@ -275,7 +280,7 @@ void YamlReader::check_keys(const YAML::Node& map, const std::string& path,
       if (score < best_score) best_score = score, best = k;
     }
     if (warn_ && ++key_warnings_ <= io_detail::kMaxKeyWarnings) {
-      std::string msg = io_detail::quote(file_) + ": " + join(path, key) + ": unknown key ignored";
+      std::string msg = where_ + ": " + join(path, key) + ": unknown key ignored";
       if (!kv.first.Mark().is_null()) msg += " (line " + std::to_string(kv.first.Mark().line + 1) + ")";
       if (!best.empty()) msg += "; did you mean '" + best + "'?";
       warn_(msg);

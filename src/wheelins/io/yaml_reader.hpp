@@ -38,6 +38,12 @@ class YamlReader {
   YamlReader(const std::filesystem::path& file, WarningSink warn, std::string kind = "YAML",
              std::string directory_hint = "");
 
+  /// Reads a YAML document already parsed (e.g. settings a study file carries); `where` names it
+  /// in messages in place of a quoted file name ("'study.yaml': run settings of job 3").
+  /// `with_lines`: the messages give the line of a value (false where the lines mean nothing,
+  /// as for values given one by one on a command line).
+  YamlReader(YAML::Node root, std::string where, WarningSink warn, bool with_lines = true);
+
   /// Reports how many unknown-key warnings were held back (past io_detail::kMaxKeyWarnings).
   ~YamlReader();
   YamlReader(const YamlReader&) = delete;
@@ -89,6 +95,8 @@ class YamlReader {
 
  private:
   std::filesystem::path file_;
+  std::string where_;  ///< the file quoted, or what the document is
+  bool with_lines_ = true;
   WarningSink warn_;
   YAML::Node root_;
   mutable int key_warnings_ = 0;  ///< unknown keys seen (check_keys is const)

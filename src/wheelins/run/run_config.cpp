@@ -52,8 +52,10 @@ struct KeyCollector {
 /// known), the value checked against its type and range, converted and stored.
 class YamlOptionReader {
  public:
-  YamlOptionReader(const YamlReader& y, fs::path base, std::map<std::string, std::vector<std::string>> keys)
-      : y_(y), base_(std::move(base)), keys_(std::move(keys)) {}
+  /// `whole`: a whole configuration (its required keys must be there), else settings over one.
+  YamlOptionReader(const YamlReader& y, fs::path base, std::map<std::string, std::vector<std::string>> keys,
+                   bool whole)
+      : y_(y), base_(std::move(base)), keys_(std::move(keys)), whole_(whole) {}
 
   void number(const OptionInfo& i, double& x, const OptionRange& r, OptionScale s = {}, double* also = nullptr) {
     if (const YAML::Node v = node(i.key); v.IsDefined()) {
@@ -83,7 +85,7 @@ class YamlOptionReader {
   void path(const OptionInfo& i, fs::path& p, bool required, const char*) {
     const YAML::Node v = node(i.key);
     if (!v.IsDefined()) {
-      if (required) (void)y_.required(y_.root(), "", i.key);  // the error naming the missing key
+      if (required && whole_) (void)y_.required(y_.root(), "", i.key);  // the error naming the missing key
       return;
     }
     const std::string text = y_.text(v, i.key);
@@ -122,6 +124,7 @@ class YamlOptionReader {
   fs::path base_;
   std::map<std::string, std::vector<std::string>> keys_;
   std::set<std::string> entered_;
+  bool whole_;
   RunConfig* config_ = nullptr;
 };
 
@@ -196,17 +199,78 @@ ReferenceWeighting weighting_from_name(const std::string& name) {
   throw InputError("reference weights '" + name + "': expected equal, covariance or standalone");
 }
 
+namespace {
+/// The settings of `y` read over `c` (`whole`: a whole configuration file).
+void read_run_config(const YamlReader& y, const fs::path& base, RunConfig& c, bool whole) {
+  KeyCollector keys;
+  RunConfig defaults;
+  declare_run_options(keys, defaults);
+  YamlOptionReader(y, base, std::move(keys.keys), whole).read_into(c);
+}
+
+RunConfig read_run_config(const YamlReader& y, const fs::path& base) {
+  RunConfig c;
+  read_run_config(y, base, c, true);
+  return c;
+}
+
+/// `--set KEY=VALUE` settings as one YAML document: {filter: {speed_window_s: 0.1}, ...}.
+YAML::Node settings_document(const std::vector<std::string>& settings) {
+  YAML::Node root(YAML::NodeType::Map);
+  for (const std::string& s : settings) {
+    const std::string where = "--set '" + s + "'";
+    const std::size_t eq = s.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(where + ": expected KEY=VALUE, a key of docs/run-config.md (e.g. fusion.position_std_m=0.3)");
+    const YAML::Node value = parse_yaml(s.substr(eq + 1), where, "value");
+    if (!value.IsDefined() || value.IsNull()) throw InputError(where + ": no value after '='");
+    const std::string key = s.substr(0, eq);
+    YAML::Node map = root;
+    for (std::size_t from = 0;;) {
+      const std::size_t dot = key.find('.', from);
+      const std::string name = key.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
+      if (name.empty()) throw InputError(where + ": an empty part in the key '" + key + "'");
+      if (dot == std::string::npos) {
+        if (map[name].IsDefined() && !map[name].IsNull()) throw InputError(where + ": " + key + " is set twice");
+        map[name] = value;
+        break;
+      }
+      if (!map[name].IsDefined() || map[name].IsNull()) map[name] = YAML::Node(YAML::NodeType::Map);
+      if (!map[name].IsMap()) throw InputError(where + ": " + key.substr(0, dot) + " is set as a value and as a section");
+      map.reset(map[name]);
+      from = dot + 1;
+    }
+  }
+  return root;
+}
+}  // namespace
+
+void apply_run_settings(const std::vector<std::string>& settings, RunConfig& c) {
+  if (settings.empty()) return;
+  // An unknown key on the command line is a typo: an error, naming the closest known key.
+  const WarningSink unknown_is_an_error = [](std::string msg) {
+    const std::string ignored = "unknown key ignored";
+    if (const auto p = msg.find(ignored); p != std::string::npos) msg.replace(p, ignored.size(), "unknown key");
+    throw InputError(msg);
+  };
+  const YamlReader y(settings_document(settings), "--set", unknown_is_an_error, false);
+  read_run_config(y, fs::path(), c, false);
+}
+
 RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {
   const YamlReader y(file, warn, "run configuration");
-  KeyCollector keys;
-  RunConfig c;
-  declare_run_options(keys, c);
-  YamlOptionReader(y, file.parent_path(), std::move(keys.keys)).read_into(c);
-  return c;
+  return read_run_config(y, file.parent_path());
+}
+
+RunConfig load_run_config(const YAML::Node& settings, const fs::path& base, const std::string& where,
+                          const WarningSink& warn) {
+  const YamlReader y(settings, where, warn);
+  return read_run_config(y, base);
 }
 
 RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
   RunConfig cfg = o.config.empty() ? RunConfig{} : load_run_config(o.config, warn);
+  apply_run_settings(o.settings, cfg);
   if (!o.manifest.empty()) cfg.manifest = o.manifest;
   if (cfg.manifest.empty())
     throw InputError("no dataset: give a run configuration naming one, or a manifest (--manifest)");

@@ -10,6 +10,10 @@
 
 #include "wheelins/run/run.hpp"
 
+namespace YAML {
+class Node;
+}
+
 namespace wheelins {
 
 struct RunConfig {
@@ -38,6 +42,10 @@ struct RunConfig {
 
 /// Reads a run configuration; relative paths resolve against the file's directory.
 RunConfig load_run_config(const std::filesystem::path& file, const WarningSink& warn);
+/// The same from settings already parsed (a study's run settings): relative paths resolve
+/// against `base`; messages name `where` instead of a file.
+RunConfig load_run_config(const YAML::Node& settings, const std::filesystem::path& base,
+                          const std::string& where, const WarningSink& warn);
 
 /// What a front end (`wheelins run`'s flags, Python's run() and Navigator()) sets over a run
 /// configuration, each setting once: an empty or unset field keeps the configuration's value.
@@ -56,7 +64,14 @@ struct RunOverrides {
   bool overwrite = false;   ///< --force
   bool full_rate = false;   ///< the trajectory files at every record
   bool subsystems = false;  ///< also each IMU's own trajectory
+  /// Any setting of docs/run-config.md as KEY=VALUE (`--set filter.speed_window_s=0.1`), over
+  /// the configuration file and under the named fields above; VALUE is YAML (`[1, 2, 1]`).
+  std::vector<std::string> settings;
 };
+
+/// `settings` (KEY=VALUE each) read over `c` with the file's checks; InputError naming the
+/// setting for a malformed one, an unknown key (and the closest known) or a value out of range.
+void apply_run_settings(const std::vector<std::string>& settings, RunConfig& c);
 
 /// The configuration file's settings (or the defaults) with `o` over them; InputError for
 /// choices that exclude each other (modules with a configuration or chips) and for no dataset.

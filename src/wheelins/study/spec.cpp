@@ -4,14 +4,10 @@
 // resolved in resolve.cpp.
 #include "wheelins/study/spec.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <set>
 
 #include "wheelins/io/manifest.hpp"
@@ -123,37 +119,16 @@ std::string Job::describe() const {
 
 RunConfig load_run_yaml(const std::string& run_yaml, const fs::path& manifest,
                         const std::string& where) {
-  static std::atomic<unsigned> counter{0};
-  // Through a file, so that the code that reads run-configuration files reads it (every
-  // key it knows, now and later, works in a study; its messages name `where`).
-  const fs::path tmp =
-      fs::temp_directory_path() / ("wheelins-study-run-" + std::to_string(::getpid()) + "-" +
-                                   std::to_string(counter++) + ".yaml");
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << "dataset: " << flow_yaml(YAML::Node(manifest.string())) << "\n" << run_yaml;
-    if (!out) throw InputError("'" + tmp.string() + "': cannot write a temporary file");
-  }
-  const std::string quoted = "'" + tmp.string() + "'";
-  auto rename_file = [&](std::string msg) {
-    for (std::size_t p; (p = msg.find(quoted)) != std::string::npos;)
-      msg.replace(p, quoted.size(), where);
+  // Read by the code that reads run-configuration files (every key it knows, now and later,
+  // works in a study), its messages naming `where`; an unknown key is an error in a study.
+  auto unknown_is_an_error = [](std::string msg) {
     const std::string ignored = "unknown key ignored";
-    if (const auto p = msg.find(ignored); p != std::string::npos)
-      msg.replace(p, ignored.size(), "unknown key");
-    return msg;
+    if (const auto p = msg.find(ignored); p != std::string::npos) msg.replace(p, ignored.size(), "unknown key");
+    throw InputError(msg);
   };
-  RunConfig cfg;
-  try {
-    cfg = load_run_config(tmp, [&](const std::string& m) { throw InputError(rename_file(m)); });
-  } catch (const InputError& e) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw InputError(rename_file(e.what()));
-  }
-  std::error_code ec;
-  fs::remove(tmp, ec);
-  return cfg;
+  const std::string text = "dataset: " + flow_yaml(YAML::Node(manifest.string())) + "\n" + run_yaml;
+  return load_run_config(parse_yaml(text, where, "run configuration"), manifest.parent_path(), where,
+                         unknown_is_an_error);
 }
 
 void check_run_yaml(const std::string& run_yaml, const std::string& where) {
