@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 #include "cli.hpp"
 #include "run_report.hpp"
@@ -14,6 +15,7 @@
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
+#include "wheelins/run/run_options.hpp"
 #include "wheelins/io/truth.hpp"
 
 namespace {
@@ -166,9 +168,12 @@ RunOverrides overrides_of(const RunArgs& a) {
 
 int run(const RunArgs& a) {
   check_range(a.duration, "--duration", 0.0, 1e7, "s", true);
-  check_range(a.output_interval, "--output-interval", 0.0, 5.0, "s (0 = every epoch)");
-  check_range(a.covariance_interval, "--covariance-interval", 0.0,
-              NavigatorOptions::kMaxCovarianceInterval, "s (0 = every epoch)");
+  for (const auto& [value, option, key] : {std::tuple{&a.output_interval, "--output-interval", "output.interval_s"},
+                                           std::tuple{&a.covariance_interval, "--covariance-interval",
+                                                      "filter.covariance_interval_s"}}) {
+    const OptionRange r = run_option_range(key);
+    check_range(*value, option, r.lo, r.hi, r.unit);
+  }
   const WarningSink warn = stderr_sink();  // one sink: each warning once
   const RunConfig cfg = run_config_with(overrides_of(a), warn);
   RunRequest req = make_run_request(cfg, warn);

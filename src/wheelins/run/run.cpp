@@ -9,6 +9,7 @@
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/text_util.hpp"
 #include "wheelins/run/input_checks.hpp"
+#include "wheelins/run/run_options.hpp"
 #include "wheelins/run/session.hpp"
 #include "wheelins/survey/checks.hpp"
 #include "wheelins/util/progress.hpp"
@@ -66,12 +67,14 @@ void validate_run_request(const RunRequest& r) {
   if (!(r.max_duration >= 0.0 && r.max_duration <= 1e7))
     throw InputError("duration: must be in (0, 1e7] s (0: all the data), got " + format_double(r.max_duration));
   const NavigatorOptions& n = r.nav;
-  if (!(n.output_interval >= 0.0 && n.output_interval <= 5.0))
-    throw InputError("output interval: must be in [0, 5] s (0 = every epoch; the evaluation "
-                     "interpolates across at most 5 s), got " + format_double(n.output_interval));
-  if (!(r.file_interval >= 0.0 && r.file_interval <= 5.0))
-    throw InputError("file interval (output.file_interval_s): must be in [0, 5] s (0 = every "
-                     "record), got " + format_double(r.file_interval));
+  const OptionRange out = run_option_range("output.interval_s"), file = run_option_range("output.file_interval_s");
+  if (!(n.output_interval >= out.lo && n.output_interval <= out.hi))
+    throw InputError("output interval: must be in [" + format_double(out.lo) + ", " + format_double(out.hi) +
+                     "] s (0 = every epoch; the evaluation interpolates across at most 5 s), got " +
+                     format_double(n.output_interval));
+  if (!(r.file_interval >= file.lo && r.file_interval <= file.hi))
+    throw InputError("file interval (output.file_interval_s): must be in [" + format_double(file.lo) + ", " +
+                     format_double(file.hi) + "] s (0 = every record), got " + format_double(r.file_interval));
   n.validate();  // the navigator's own ranges (the covariance interval, the update intervals)
   if (n.fusion.centralized && r.modules.size() < 2)
     throw InputError("the centralized filter joins several IMUs; a run of one module ('" +

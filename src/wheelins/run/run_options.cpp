@@ -3,7 +3,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 
 namespace wheelins {
 namespace {
@@ -87,7 +89,38 @@ class MarkdownRows {
   std::ostringstream out_;
 };
 
+/// Finds one number setting's range (copied: the declarations' ranges are temporaries).
+struct RangeFinder {
+  std::string key;
+  std::optional<OptionRange> range;
+  void number(const OptionInfo& i, double&, const OptionRange& r, OptionScale = {}, double* = nullptr) {
+    if (key == i.key) range = r;
+  }
+  void rate(const OptionInfo& i, double&, const OptionRange& r) {
+    if (key == i.key) range = r;
+  }
+  void whole(const OptionInfo&, int&, int, int) {}
+  void vec3(const OptionInfo&, Vec3&, const OptionRange&) {}
+  void flag(const OptionInfo&, bool&) {}
+  void path(const OptionInfo&, std::filesystem::path&, bool, const char*) {}
+  template <class E>
+  void choice(const OptionInfo&, E&, const OptionChoices<E>&) {}
+  template <class F>
+  void custom(const OptionInfo&, const char*, const char*, F&&) {}
+  template <class F>
+  void section_check(const char*, F&&) {}
+};
+
 }  // namespace
+
+OptionRange run_option_range(const std::string& key) {
+  RangeFinder finder;
+  finder.key = key;
+  RunConfig c;
+  declare_run_options(finder, c);
+  if (!finder.range) throw std::logic_error("run_option_range: '" + key + "' is not a declared number");
+  return *finder.range;
+}
 
 std::string run_options_markdown() {
   MarkdownRows rows;

@@ -60,6 +60,11 @@ const OptionChoices<SpeedSharing>& speed_sharing_choices();
 const OptionChoices<YawScaleFactorChoice>& yaw_scale_factor_choices();
 const OptionChoices<CalibrationMode>& calibration_mode_choices();
 
+/// The declared range of the number setting `key` ("output.interval_s"), for the checks of a
+/// value that comes from elsewhere than the file (a command-line option, a RunRequest built in
+/// code); std::logic_error for a key that is not a declared number.
+OptionRange run_option_range(const std::string& key);
+
 /// The documentation's table of every setting (docs/run-config.md, "Settings"): key, option,
 /// range, default, meaning; a test keeps the documentation equal to it.
 std::string run_options_markdown();
