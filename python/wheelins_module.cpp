@@ -197,7 +197,7 @@ RunOverrides shared_settings(const py::object& manifest, const std::string& conf
                              std::optional<bool> position_constraint, std::optional<bool> fault_handling,
                              std::optional<double> duration, std::optional<double> output_interval,
                              std::optional<double> covariance_interval, const std::string& yaw_scale_factors,
-                             const std::string& calibration) {
+                             const std::string& calibration, const std::vector<std::string>& settings) {
   RunOverrides s;
   s.config = text(config).value_or("");
   s.manifest = text(manifest).value_or("");
@@ -213,6 +213,7 @@ RunOverrides shared_settings(const py::object& manifest, const std::string& conf
   s.duration = duration;
   s.output_interval = output_interval;
   s.covariance_interval = covariance_interval;
+  s.settings = settings;  // KEY=VALUE each, as `--set`
   return s;
 }
 
@@ -242,10 +243,10 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
               std::optional<double> covariance_interval, const std::string& weights,
               std::optional<bool> fixed_noise, const std::string& yaw_scale_factors,
               const std::string& calibration, bool force, bool progress, bool full_rate,
-              bool subsystems) {
+              bool subsystems, const std::vector<std::string>& settings) {
   RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
                                    position_constraint, fault_handling, duration, output_interval,
-                                   covariance_interval, yaw_scale_factors, calibration);
+                                   covariance_interval, yaw_scale_factors, calibration, settings);
   s.formats = formats;
   s.weights = weights;
   s.fixed_noise = fixed_noise;
@@ -394,7 +395,7 @@ class StreamNavigator {
                   std::optional<bool> fault_handling, std::optional<double> duration,
                   std::optional<double> output_interval, std::optional<double> covariance_interval,
                   const std::string& yaw_scale_factors, const std::string& calibration,
-                  double calibration_warmup);
+                  double calibration_warmup, const std::vector<std::string>& settings);
 
   int index_of(const py::object& module) const;
 
@@ -454,7 +455,8 @@ StreamNavigator::StreamNavigator(const py::object& manifest, const std::string& 
                                  std::optional<bool> position_constraint, std::optional<bool> fault_handling,
                                  std::optional<double> duration, std::optional<double> output_interval,
                                  std::optional<double> covariance_interval, const std::string& yaw_scale_factors,
-                                 const std::string& calibration, double calibration_warmup) {
+                                 const std::string& calibration, double calibration_warmup,
+                                 const std::vector<std::string>& settings) {
   // It sees each sample once. "manifest" (the default): the manifest's geometry as it is
   // (a calibrated manifest comes from `wheelins calibrate`). "estimate": the installation
   // geometry estimated from the first `calibration_warmup` seconds after the static period,
@@ -462,7 +464,7 @@ StreamNavigator::StreamNavigator(const py::object& manifest, const std::string& 
   const RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
                                          position_constraint, fault_handling, duration, output_interval,
                                          covariance_interval, yaw_scale_factors,
-                                         calibration.empty() ? "manifest" : calibration);
+                                         calibration.empty() ? "manifest" : calibration, settings);
   const WarningSink warn = stderr_sink();
   RunRequest req = make_run_request(run_config_with(s, warn), warn);
   req.output_dir.clear();
@@ -574,7 +576,8 @@ void bind_functions(py::module_& m) {
         py::arg("duration") = py::none(), py::arg("output_interval") = py::none(),
         py::arg("covariance_interval") = py::none(), py::arg("weights") = "", py::arg("fixed_noise") = py::none(),
         py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("force") = false,
-        py::arg("progress") = false, py::arg("full_rate") = false, py::arg("subsystems") = false);
+        py::arg("progress") = false, py::arg("full_rate") = false, py::arg("subsystems") = false,
+        py::arg("settings") = std::vector<std::string>{});
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
         py::arg("origin") = py::none(), py::arg("series") = false);
@@ -588,13 +591,14 @@ void bind_navigator(py::module_& m) {
       .def(py::init<const py::object&, const std::string&, const std::vector<std::string>&, const std::vector<std::string>&,
                     const py::object&, const std::string&, std::optional<bool>, std::optional<bool>, std::optional<bool>,
                     std::optional<double>, std::optional<double>, std::optional<double>, const std::string&,
-                    const std::string&, double>(),
+                    const std::string&, double, const std::vector<std::string>&>(),
            py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
            py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("speed") = "",
            py::arg("centralized") = py::none(), py::arg("position_constraint") = py::none(),
            py::arg("fault_handling") = py::none(), py::arg("duration") = py::none(),
            py::arg("output_interval") = py::none(), py::arg("covariance_interval") = py::none(),
-           py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("calibration_warmup") = 120.0)
+           py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("calibration_warmup") = 120.0,
+           py::arg("settings") = std::vector<std::string>{})
       .def("push", &StreamNavigator::push, py::arg("module"), py::arg("t"), py::arg("gyro"), py::arg("accel"))
       .def("finish", &StreamNavigator::finish)
       .def("covariance", &StreamNavigator::covariance, py::arg("module") = 0)

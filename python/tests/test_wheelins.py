@@ -135,6 +135,26 @@ def test_run_weights_and_fixed_noise_as_the_cli(dataset, tmp_path):
         wheelins.run(dataset["manifest"], "triple", weights="inverse", duration=5.0)
 
 
+def test_settings_set_any_key_as_the_clis_set(dataset, tmp_path):
+    settings = {"fusion.position_std_m": 0.5, "fusion.weights": [1, 2, 1], "standstill.enabled": False}
+    r = wheelins.run(dataset["manifest"], "triple", out=tmp_path / "py", formats=["csv"], duration=20.0,
+                     settings=settings)
+    cli("run", "--full-rate", "-m", dataset["manifest"], "-c", "triple", "-o", tmp_path / "cli", "--formats", "csv",
+        "--duration", 20, "--set", "fusion.position_std_m=0.5", "--set", "fusion.weights=[1, 2, 1]",
+        "--set", "standstill.enabled=false", "-q")
+    same_as_csv(r.trajectory, read_csv(tmp_path / "cli" / "trajectory.csv"))
+    plain = wheelins.run(dataset["manifest"], "triple", duration=20.0)
+    assert not np.array_equal(plain.trajectory["north_m"], r.trajectory["north_m"])
+    nav = wheelins.Navigator(dataset["manifest"], configuration="triple", settings={"filter.velocity_update_hz": 4})
+    assert nav is not None
+    with pytest.raises(ValueError, match="fusion.position_std: unknown key"):
+        wheelins.run(dataset["manifest"], "triple", duration=5.0, settings={"fusion.position_std": 0.5})
+    with pytest.raises(ValueError, match=r"must be in \[0.001, 100\] m"):
+        wheelins.run(dataset["manifest"], "triple", duration=5.0, settings={"fusion.position_std_m": 500})
+    with pytest.raises(ValueError, match="a dict"):
+        wheelins.run(dataset["manifest"], "triple", duration=5.0, settings=["fusion.position_std_m=1"])
+
+
 def load_rows(dataset, module_file):
     return np.fromfile(os.path.join(os.path.dirname(dataset["manifest"]), module_file), dtype="<f8").reshape(-1, 7)
 

@@ -45,10 +45,10 @@ __all__ = ["InputError", "Navigator", "Result", "csv_columns", "evaluate", "read
 # The keyword arguments of run() and Navigator() beyond their named ones: the options of
 # `wheelins run` by name.
 _RUN_SETTINGS = ("speed", "centralized", "position_constraint", "fault_handling", "duration", "output_interval",
-                 "covariance_interval", "weights", "fixed_noise", "yaw_scale_factors", "calibration")
+                 "covariance_interval", "weights", "fixed_noise", "yaw_scale_factors", "calibration", "settings")
 _NAVIGATOR_SETTINGS = ("speed", "centralized", "position_constraint", "fault_handling", "duration",
                        "output_interval", "covariance_interval", "yaw_scale_factors", "calibration",
-                       "calibration_warmup")
+                       "calibration_warmup", "settings")
 _EVALUATE_OPTIONS = ("format", "truth_layout", "segment", "max_gap", "align", "origin")
 
 
@@ -60,6 +60,19 @@ def _check_keywords(function, given, known):
             hint = f"; did you mean {near[0]!r}?" if near else ""
             raise TypeError(f"{function}() got an unexpected keyword argument {key!r}{hint} "
                             f"(it takes: {', '.join(known)})")
+
+
+def _run_settings(filter_settings):
+    """settings={"fusion.position_std_m": 0.3} (or nested: {"fusion": {...}}): any key of the
+    run configuration (docs/run-config.md), as `wheelins run --set KEY=VALUE` each."""
+    settings = filter_settings.pop("settings", None)
+    if settings is None:
+        return filter_settings
+    if not isinstance(settings, dict):
+        raise InputError("settings: a dict {key: value} of the run configuration's keys (docs/run-config.md)")
+    flat = []
+    _flatten("", settings, flat)
+    return {**filter_settings, "settings": flat}
 
 
 def _yaml(text):
@@ -162,7 +175,9 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
     fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0,
     weights="covariance" (or "equal"), fixed_noise=True, yaw_scale_factors="held" (or "auto",
     "constraint", "estimated"), calibration="manifest" (or "estimate", the default: the
-    Wheel-IMUs' mounting and lever arm estimated from the data first).
+    Wheel-IMUs' mounting and lever arm estimated from the data first). settings: any key
+    of the run configuration (docs/run-config.md) as `--set` takes it, e.g.
+    settings={"fusion.position_std_m": 0.3, "fusion.weights": [1, 2, 1]}.
     """
     _check_keywords("run", filter_settings, _RUN_SETTINGS)
     if isinstance(chips, str):
@@ -170,7 +185,7 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
     return Result(_core.run(manifest, configuration=configuration or "", chips=list(chips or []),
                             modules=list(modules or []), config=config, out=out, formats=list(formats or []),
                             evaluate=evaluate, progress=progress, force=force, full_rate=full_rate,
-                            subsystems=subsystems, **filter_settings))
+                            subsystems=subsystems, **_run_settings(filter_settings)))
 
 
 _SERIES = ["t_s", "distance_m", "err_n_m", "err_e_m", "err_d_m", "err_h_m", "heading_err_deg", "sigma_h_m", "nees_h"]
@@ -244,7 +259,8 @@ class Navigator:
                 _json.dump(spec, f)
         try:
             self._nav = _core.Navigator(manifest, configuration=configuration or "", chips=list(chips or []),
-                                        modules=list(modules or []), config=config, **filter_settings)
+                                        modules=list(modules or []), config=config,
+                                        **_run_settings(filter_settings))
         finally:
             if tmp:
                 _shutil.rmtree(tmp, ignore_errors=True)
