@@ -15,21 +15,27 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// "filter.initial_std.heading_deg" -> {filter, initial_std, heading_deg} (empty parts kept).
+std::vector<std::string> key_parts(const std::string& key) {
+  std::vector<std::string> parts;
+  for (std::size_t from = 0;;) {
+    const std::size_t dot = key.find('.', from);
+    parts.push_back(key.substr(from, dot == std::string::npos ? std::string::npos : dot - from));
+    if (dot == std::string::npos) return parts;
+    from = dot + 1;
+  }
+}
+
 /// The keys each map of the file may hold ("" for the top), from the declarations' dotted keys.
 struct KeyCollector {
   std::map<std::string, std::vector<std::string>> keys;
 
   void add(const std::string& key) {
     std::string parent;
-    std::size_t from = 0;
-    for (;;) {
-      const std::size_t dot = key.find('.', from);
-      const std::string name = key.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
+    for (const std::string& name : key_parts(key)) {
       auto& list = keys[parent];
       if (std::find(list.begin(), list.end(), name) == list.end()) list.push_back(name);
-      if (dot == std::string::npos) return;
-      parent = key.substr(0, dot);
-      from = dot + 1;
+      parent += (parent.empty() ? "" : ".") + name;
     }
   }
   void number(const OptionInfo& i, double&, const OptionRange&, OptionScale = {}, double* = nullptr) {
@@ -131,19 +137,16 @@ class YamlOptionReader {
 YAML::Node YamlOptionReader::node(const std::string& key) {
   std::vector<YAML::Node> way{y_.root()};
   std::string path;
-  std::size_t from = 0;
-  for (;;) {
+  for (const std::string& name : key_parts(key)) {
+    if (!way.back().IsDefined()) break;
     if (entered_.insert(path).second) {
       if (!path.empty()) y_.require_map(way.back(), path);
       y_.check_keys(way.back(), path, keys_[path]);
     }
-    const std::size_t dot = key.find('.', from);
-    const std::string name = key.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
     way.push_back(YamlReader::get(way.back(), name));
-    if (dot == std::string::npos || !way.back().IsDefined()) return way.back();
-    path = key.substr(0, dot);
-    from = dot + 1;
+    path += (path.empty() ? "" : ".") + name;
   }
+  return way.back();
 }
 
 }  // namespace
@@ -225,20 +228,21 @@ YAML::Node settings_document(const std::vector<std::string>& settings) {
     const YAML::Node value = parse_yaml(s.substr(eq + 1), where, "value");
     if (!value.IsDefined() || value.IsNull()) throw InputError(where + ": no value after '='");
     const std::string key = s.substr(0, eq);
+    const std::vector<std::string> parts = key_parts(key);
     YAML::Node map = root;
-    for (std::size_t from = 0;;) {
-      const std::size_t dot = key.find('.', from);
-      const std::string name = key.substr(from, dot == std::string::npos ? std::string::npos : dot - from);
+    std::string path;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const std::string& name = parts[k];
       if (name.empty()) throw InputError(where + ": an empty part in the key '" + key + "'");
-      if (dot == std::string::npos) {
+      path += (path.empty() ? "" : ".") + name;
+      if (k + 1 == parts.size()) {
         if (map[name].IsDefined() && !map[name].IsNull()) throw InputError(where + ": " + key + " is set twice");
         map[name] = value;
         break;
       }
       if (!map[name].IsDefined() || map[name].IsNull()) map[name] = YAML::Node(YAML::NodeType::Map);
-      if (!map[name].IsMap()) throw InputError(where + ": " + key.substr(0, dot) + " is set as a value and as a section");
+      if (!map[name].IsMap()) throw InputError(where + ": " + path + " is set as a value and as a section");
       map.reset(map[name]);
-      from = dot + 1;
     }
   }
   return root;
@@ -248,13 +252,16 @@ YAML::Node settings_document(const std::vector<std::string>& settings) {
 void apply_run_settings(const std::vector<std::string>& settings, RunConfig& c) {
   if (settings.empty()) return;
   // An unknown key on the command line is a typo: an error, naming the closest known key.
-  const WarningSink unknown_is_an_error = [](std::string msg) {
+  const YamlReader y(settings_document(settings), "--set", warnings_are_errors(), false);
+  read_run_config(y, fs::path(), c, false);
+}
+
+WarningSink warnings_are_errors() {
+  return [](std::string msg) {
     const std::string ignored = "unknown key ignored";
     if (const auto p = msg.find(ignored); p != std::string::npos) msg.replace(p, ignored.size(), "unknown key");
     throw InputError(msg);
   };
-  const YamlReader y(settings_document(settings), "--set", unknown_is_an_error, false);
-  read_run_config(y, fs::path(), c, false);
 }
 
 RunConfig load_run_config(const fs::path& file, const WarningSink& warn) {

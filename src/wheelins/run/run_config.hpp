@@ -69,6 +69,10 @@ struct RunOverrides {
   std::vector<std::string> settings;
 };
 
+/// For settings where a leftover key cannot be meant (a command line, a study's run settings):
+/// every warning of the reading is an InputError, "unknown key ignored" said as "unknown key".
+WarningSink warnings_are_errors();
+
 /// `settings` (KEY=VALUE each) read over `c` with the file's checks; InputError naming the
 /// setting for a malformed one, an unknown key (and the closest known) or a value out of range.
 void apply_run_settings(const std::vector<std::string>& settings, RunConfig& c);

@@ -121,14 +121,9 @@ RunConfig load_run_yaml(const std::string& run_yaml, const fs::path& manifest,
                         const std::string& where) {
   // Read by the code that reads run-configuration files (every key it knows, now and later,
   // works in a study), its messages naming `where`; an unknown key is an error in a study.
-  auto unknown_is_an_error = [](std::string msg) {
-    const std::string ignored = "unknown key ignored";
-    if (const auto p = msg.find(ignored); p != std::string::npos) msg.replace(p, ignored.size(), "unknown key");
-    throw InputError(msg);
-  };
   const std::string text = "dataset: " + flow_yaml(YAML::Node(manifest.string())) + "\n" + run_yaml;
   return load_run_config(parse_yaml(text, where, "run configuration"), manifest.parent_path(), where,
-                         unknown_is_an_error);
+                         warnings_are_errors());
 }
 
 void check_run_yaml(const std::string& run_yaml, const std::string& where) {
