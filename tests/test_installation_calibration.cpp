@@ -1,4 +1,4 @@
-// The Wheel-IMU installation calibration (filter/installation_calibration.hpp,
+// The Wheel-IMU installation calibration (calib/installation_calibration.hpp,
 // run/calibration.hpp): synthetic spins with known geometry (the algebra, what is and is
 // not observable), and a short simulated run with the field profile's calibration
 // residuals (convergence from the manifest's wrong values to the truth within 3 sigma,
@@ -16,7 +16,7 @@
 #include <sstream>
 
 #include "wheelins/eval/metrics.hpp"
-#include "wheelins/filter/installation_calibration.hpp"
+#include "wheelins/calib/installation_calibration.hpp"
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/trajectory.hpp"
 #include "wheelins/io/truth.hpp"

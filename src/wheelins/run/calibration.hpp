@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "wheelins/filter/installation_calibration.hpp"
+#include "wheelins/calib/installation_calibration.hpp"
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/manifest.hpp"
 
