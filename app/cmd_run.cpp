@@ -11,7 +11,7 @@
 #include "cli.hpp"
 #include "run_report.hpp"
 #include "wheelins/eval/run_evaluation.hpp"
-#include "wheelins/fusion/reference_weights.hpp"
+#include "wheelins/fusion/aids/position_constraint/reference_weights.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"

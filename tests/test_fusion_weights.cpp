@@ -1,5 +1,5 @@
 // The reference weights of eq. (8) from each subsystem's own uncertainty
-// (fusion/reference_weights.hpp): the variance of a subsystem's reference point, the
+// (fusion/aids/position_constraint/reference_weights.hpp): the variance of a subsystem's reference point, the
 // averaged inverse-variance weights, a module leaving and rejoining the mean, the
 // record over time (weights.csv) and the run configuration's keys. The end-to-end case
 // (a poor chip counts less) is FusionFaults.APoorChipCountsLessWithWeightsFromTheCovariance.
@@ -10,7 +10,7 @@
 
 #include "io_test_util.hpp"
 #include "wheelins/fusion/centralized.hpp"
-#include "wheelins/fusion/reference_weights.hpp"
+#include "wheelins/fusion/aids/position_constraint/reference_weights.hpp"
 #include "wheelins/run/run_config.hpp"
 
 using namespace wheelins;

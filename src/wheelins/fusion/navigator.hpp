@@ -10,12 +10,16 @@
 // Wheel-INSs, or each wheel's own) and every subsystem fuses its velocity + NHC
 // (eq. 5, 6); at the position-constraint rate the weighted mean of the subsystems'
 // reference points (eq. 7, 8) is a position measurement for each of them (eq. 11).
-// The navigator holds the parts and calls them in that order (process()):
+// The navigator holds the parts and reads as: propagate -> each aid steps -> output
+// (process()):
 //   Subsystems     the Wheel-INSs and the Body-INS            (subsystems.hpp)
-//   measurements   built once for both filter structures      (measurement.hpp)
 //   FilterBackend  distributed (the paper) or centralized     (filter_backend.hpp)
+//   the aids       one folder each: wheel velocity, zero motion, position constraint
+//                  (aids/, aid.hpp), their measurements built once for both filter
+//                  structures (measurement.hpp)
 //   OutputFusion   the vehicle solution and the records       (output.hpp)
-//   FaultHandler   sensor faults, behind a few hooks          (fault_handler.hpp)
+//   FaultHandler   the fault policy: decides which modules the aids use, behind a few hooks
+//                                                             (fault_handler.hpp)
 //   NoiseAdaptation the noise model learned from the data     (noise_adaptation.hpp)
 #pragma once
 
@@ -24,14 +28,16 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/fusion/aids/aid.hpp"
+#include "wheelins/fusion/aids/position_constraint/position_constraint_aid.hpp"
+#include "wheelins/fusion/aids/wheel_velocity/wheel_velocity_aid.hpp"
+#include "wheelins/fusion/aids/zero_motion/zero_motion_aid.hpp"
 #include "wheelins/fusion/fault_handler.hpp"
 #include "wheelins/fusion/filter_backend.hpp"
 #include "wheelins/fusion/measurement.hpp"
 #include "wheelins/fusion/noise_adaptation.hpp"
 #include "wheelins/fusion/options.hpp"
 #include "wheelins/fusion/output.hpp"
-#include "wheelins/fusion/reference_weights.hpp"
-#include "wheelins/fusion/standstill.hpp"
 #include "wheelins/fusion/subsystems.hpp"
 #include "wheelins/nav/trajectory_record.hpp"
 #include "wheelins/nav/vehicle.hpp"
@@ -59,7 +65,8 @@ class Navigator {
   void process(int index, const ImuSample& raw);
 
   bool navigating() const { return navigating_; }
-  const NavigatorStats& stats() const { return stats_; }
+  /// The counters, the aids' included.
+  const NavigatorStats& stats() const;
   int subsystem_count() const { return subs_.size(); }
   const Subsystem& subsystem(int i) const { return subs_.at(i); }
   Subsystem& subsystem(int i) { return subs_.at(i); }
@@ -69,8 +76,8 @@ class Navigator {
   /// (eq. 11). With fault handling, only the modules that count enter the mean wheel speed
   /// and the reference (the velocity measurement uses the speed selection of the last
   /// update epoch).
-  void velocity_measurement(int i, Measurement& m) const;
-  void position_measurement(int i, Measurement& m) const;
+  void velocity_measurement(int i, Measurement& m) const { velocity_.measurement(i, m); }
+  void position_measurement(int i, Measurement& m) const { position_.measurement(i, m); }
   /// The fused vehicle solution now.
   TrajectoryRecord vehicle_record() const;
   /// Health, counters and the report of detected faults.
@@ -80,50 +87,21 @@ class Navigator {
   /// What the noise identification found for subsystem i, with the consistency figures and
   /// the warnings (noise_adaptation.hpp).
   ModuleNoiseReport noise_report(int i) const { return noise_.report(i); }
-  /// The reference weights of eq. (8) at every constraint epoch (reference_weights.hpp).
-  const std::vector<WeightRecord>& weight_history() const { return weights_.history(); }
+  /// The reference weights of eq. (8) at every constraint epoch (aids/position_constraint/reference_weights.hpp).
+  const std::vector<WeightRecord>& weight_history() const { return position_.weight_history(); }
 
  private:
-  using Use = std::array<bool, kMaxModules>;
   void start_navigation(double t0);
-  /// The velocity + NHC updates of every module in use, and the position constraint of
-  /// every module tied to the others. Both expect every covariance at the current epoch
-  /// (process() flushes them first).
-  void velocity_step();
-  void position_step();
-  /// The velocity step of a standing vehicle: every quiet subsystem in use fuses zero velocity
-  /// and zero angular rate (standstill.hpp) instead of its wheel-speed update.
-  void zero_motion_step();
-  /// The Body-INS level is shared: sharing on and the Body-INS counted.
-  bool level_shared() const;
+  /// The velocity-update epoch at time t: the zero-motion aid's updates while the vehicle
+  /// stands, else the wheel-velocity aid's. Expects every covariance at t.
+  void velocity_epoch(double t);
   /// The vehicle's heading from a counted subsystem that does not steer, other than `except`
   /// (a steered wheel's start); SteeringObserver::kNoHeading with none.
   double unsteered_heading(int except) const;
-  /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
-  void share_level();
-  /// The wheel speeds of this velocity step: the paper's mean over the wheels, less what
-  /// the fault handling screens out.
-  void select_speeds(double t);
-  /// The shared quantities of the velocity step (speeds_ selection) and of the position step
-  /// (sh.k weights), at the current state; `level_now`: see SharedInputs::level_now.
-  void take_speeds(SharedInputs& sh, bool level_now) const;
-  void take_reference(SharedInputs& sh, bool level_now) const;
-  /// The reference weights k (eq. 8) renormalised over the counted modules (0 for the
-  /// others); false when no module counts.
-  bool reference_weights(std::array<double, kMaxModules>& k, int& n_ref, int& n_tied) const;
-  /// ReferenceWeighting::kCovariance: every subsystem's o variance into the weights, which
-  /// become the subsystems' k_i (Subsystems::set_weights) for this epoch on.
-  void update_weights();
-  void count_velocity_update(int i, const UpdateReport& rep, double t);
   /// Covariance health of every subsystem in use (Cholesky test, asymmetry).
   void check_covariances();
-  /// Time of the subsystem in use that is furthest behind.
-  double min_time() const;
   /// The first module in use: it drives the output epochs (-1 if none).
   int output_driver() const;
-  Use in_use_mask() const;
-  /// Which modules the vehicle solution is made of now.
-  Use vehicle_modules() const;
 
   NavigatorOptions opt_;
   earth::LocalFrame frame_;
@@ -134,17 +112,20 @@ class Navigator {
   OutputFusion output_;
   std::unique_ptr<FaultHandler> faults_;
   NoiseAdaptation noise_;
-  ReferenceWeights weights_;
-  StandstillDetector standstill_;
+  SharedInputs shared_;    ///< scratch of the aids (no allocation per epoch)
+  Measurement meas_;       ///< scratch of the aids
+  AidContext ctx_;         ///< the parts above, as the aids see them
+  // The aid sources (aids/), each with its schedule and statistics.
+  WheelVelocityAid velocity_;
+  ZeroMotionAid zero_motion_;
+  PositionConstraintAid position_;
   double last_sample_t_ = -1e300;  ///< the newest sample of any module (outage rule)
   std::vector<StaticAccumulator> static_;
-  SharedInputs shared_;    ///< scratch of the update steps (no allocation per epoch)
-  Measurement meas_;       ///< scratch of the update steps
-  SpeedSelection speeds_;  ///< the wheel speeds usable at the last update epoch
   bool navigating_ = false;
   double last_output_t_ = -1e300;
-  double next_output_t_ = 0.0, next_velocity_t_ = 0.0, next_position_t_ = 0.0;
-  NavigatorStats stats_;
+  double next_output_t_ = 0.0;
+  /// The counters of the navigator; the aids' are copied in by stats().
+  mutable NavigatorStats stats_;
 };
 
 }  // namespace wheelins

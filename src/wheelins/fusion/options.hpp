@@ -34,10 +34,10 @@ enum class YawScaleFactorChoice {
 /// Where the reference weights k_i of eq. (8) come from.
 enum class ReferenceWeighting {
   kFixed,       ///< FusionOptions::weights (empty: equal), the paper
-  kCovariance,  ///< each subsystem's own uncertainty of o: inverse variance (reference_weights.hpp)
+  kCovariance,  ///< each subsystem's own uncertainty of o: inverse variance (aids/position_constraint/reference_weights.hpp)
   /// Each subsystem's drift on its own, without the constraint: the inverse of the lateral
   /// variance of its constraint-free heading model (a federated filter's no-reset weights;
-  /// StandaloneDrift in reference_weights.hpp). A Body-IMU's unmodulated yaw bias counts.
+  /// StandaloneDrift in aids/position_constraint/reference_weights.hpp). A Body-IMU's unmodulated yaw bias counts.
   kStandalone,
 };
 
@@ -70,7 +70,7 @@ struct NoiseAdaptationOptions {
   void validate() const;
 };
 
-/// Zero-velocity detection while the vehicle stands (standstill.hpp, docs/faults.md).
+/// Zero-velocity detection while the vehicle stands (aids/zero_motion/standstill.hpp, docs/faults.md).
 struct StandstillOptions {
   bool enabled = true;
   double max_rate = 1.0 * kDeg;     ///< [rad/s] every IMU's compensated rate (block means) below

@@ -86,7 +86,7 @@ SpeedSharing speed_sharing_from_name(const std::string& name);
 YawScaleFactorChoice yaw_scale_factors_from_name(const std::string& name);
 /// `estimate` or `manifest` (run/calibration.hpp); InputError otherwise.
 CalibrationMode calibration_mode_from_name(const std::string& name);
-/// `equal` (the paper) or `covariance` (reference_weights.hpp); InputError otherwise.
+/// `equal` (the paper) or `covariance` (fusion/aids/position_constraint/reference_weights.hpp); InputError otherwise.
 ReferenceWeighting weighting_from_name(const std::string& name);
 
 /// Loads the manifest, resolves the modules and fills a RunRequest.

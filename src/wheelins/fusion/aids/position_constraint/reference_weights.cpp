@@ -1,5 +1,5 @@
 // The reference weights of reference_weights.hpp (paper eq. 8).
-#include "wheelins/fusion/reference_weights.hpp"
+#include "wheelins/fusion/aids/position_constraint/reference_weights.hpp"
 
 #include <algorithm>
 #include <cstdio>

@@ -1,5 +1,5 @@
 // The standstill detector of standstill.hpp.
-#include "wheelins/fusion/standstill.hpp"
+#include "wheelins/fusion/aids/zero_motion/standstill.hpp"
 
 #include <algorithm>
 
