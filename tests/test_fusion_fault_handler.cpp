@@ -147,7 +147,13 @@ TEST(FaultHandler, ModuleWithoutDataGoesOutThenRealignsRestartsAndPassesProbatio
   EXPECT_TRUE(h->tied(1));
   EXPECT_FALSE(h->counted(1));
   EXPECT_EQ(h->monitor().stats(1).restarts, 1u);
-  EXPECT_NEAR((*rig.subs)[1].time(), back + o.realign_time, 0.02);  // restarted at that time
+  // The policy decided the restart at that time; the navigator's parts carry it out
+  // (AidContext::act_on_faults, tested end to end by FusionFaults.*).
+  const FaultActions act = h->take_actions();
+  ASSERT_TRUE(act.restart.has_value());
+  EXPECT_EQ(act.restart->module, 1);
+  EXPECT_NEAR(act.restart->fix.t, back + o.realign_time, 0.02);
+  EXPECT_FALSE(h->actions_pending());
   // Probation passes at the first velocity step probation seconds later.
   const double since = h->monitor().since(1);
   h->on_velocity_step(since + o.probation - 0.1);
@@ -306,5 +312,13 @@ TEST(FaultHandler, RestartAfterIsolationTakesTheSensorErrorsOfBeforeTheFault) {
   ASSERT_EQ(h->monitor().health(2), Health::kRealign);
   Rig::feed(*h, {0, 1, 2}, retry - 0.1, retry + o.realign_time + 0.01);
   EXPECT_EQ(h->monitor().health(2), Health::kProbation);
-  EXPECT_EQ(ekf.errors().bg, good.bg);
+  // The policy decided the restart with the estimates of before the fault (the navigator's
+  // parts set them: AidContext::act_on_faults); it changed no filter itself.
+  const FaultActions act = h->take_actions();
+  ASSERT_TRUE(act.restart.has_value());
+  EXPECT_EQ(act.restart->module, 2);
+  EXPECT_TRUE(act.restart->revert_errors);
+  EXPECT_EQ(act.restart->errors.bg, good.bg);
+  EXPECT_EQ(ekf.errors().bg, bad.bg);
+  EXPECT_TRUE(act.forget_heading_offset[2]);  // its offset was tracked while the fault went undetected
 }

@@ -42,14 +42,14 @@ void FaultHandler::finish(double t) {
   }
 }
 
-std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, Subsystems& subs,
-                                                 FilterBackend& filter, OutputFusion& output) {
+std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, const Subsystems& subs,
+                                                 const FilterBackend& filter, const OutputFusion& output) {
   if (options.enabled) return std::make_unique<FaultPolicy>(options, subs, filter, output);
   return std::make_unique<NoFaultHandling>(names_of(subs), options);
 }
 
-FaultPolicy::FaultPolicy(const FaultOptions& options, Subsystems& subs, FilterBackend& filter,
-                         OutputFusion& output)
+FaultPolicy::FaultPolicy(const FaultOptions& options, const Subsystems& subs, const FilterBackend& filter,
+                         const OutputFusion& output)
     : FaultHandler(FaultMonitor(names_of(subs), options)),
       opt_(options),
       subs_(subs),
@@ -377,7 +377,7 @@ void FaultPolicy::isolate(int i, double t, const std::string& what) {
   rt_[i].revert_errors = true;
   rt_[i].heading_fails = 0;
   // Its heading offset was tracked while the fault went undetected: not to be trusted.
-  output_.forget_heading_offset(i);
+  actions_.forget_heading_offset[static_cast<std::size_t>(i)] = true;
 }
 
 void FaultPolicy::on_position_step(double t) {
@@ -434,7 +434,10 @@ VehicleFix FaultPolicy::vehicle_fix(int i, double t) const {
     // module's own offset from it before the outage: what the others' gyros say it turned
     // by since. Its yaw-rate scale factor's share of its heading is kept, not lost to theirs.
     double offset = 0.0;
-    fix.heading = wrap_pi(r.rpy.z() + (output_.heading_offset(i, offset) ? offset : 0.0));
+    // (An offset this policy decided to forget and is not yet forgotten does not count.)
+    const bool own_offset = !actions_.forget_heading_offset[static_cast<std::size_t>(i)] &&
+                            output_.heading_offset(i, offset);
+    fix.heading = wrap_pi(r.rpy.z() + (own_offset ? offset : 0.0));
     fix.position_std = r.p_std.norm() + 0.05;
     fix.heading_std = r.rpy_std.z() + 0.5 * kDeg;
     return fix;
@@ -453,14 +456,16 @@ VehicleFix FaultPolicy::vehicle_fix(int i, double t) const {
 
 void FaultPolicy::restart(int i, double t) {
   const VehicleFix fix = vehicle_fix(i, t);
-  if (rt_[i].revert_errors && rt_[i].have_snapshot) {
-    // The sensor-error estimates learnt while the fault went undetected are not trusted:
-    // back to those of 10-20 s before the detection.
-    subs_[i].ekf().set_errors(rt_[i].errors_old);
-  }
+  FaultActions::Restart r;
+  r.module = i;
+  // The sensor-error estimates learnt while the fault went undetected are not trusted:
+  // back to those of 10-20 s before the detection.
+  r.revert_errors = rt_[i].revert_errors && rt_[i].have_snapshot;
+  r.errors = rt_[i].errors_old;
+  r.f_now = rt_[i].realign.mean_f_now();
+  r.fix = fix;
+  actions_.restart = r;
   rt_[i].revert_errors = false;
-  subs_[i].restart(rt_[i].realign.mean_f_now(), fix);
-  filter_.restarted(i);
   monitor_.clear_tests(i);
   ++monitor_.stats(i).restarts;
   rt_[i].detector_fired = false;

@@ -16,13 +16,16 @@
 // (receives the position constraint).
 //
 // NoFaultHandling, when fault handling is off, keeps every module in use and counted and
-// acts on nothing. FaultPolicy decides and acts: it restarts a module from the others
-// (through the subsystems, the filter back-end and the output fusion it is given).
+// decides nothing. FaultPolicy decides; it reads the subsystems, the filter back-end and the
+// output fusion and changes none of them: what is to be done to a module (restart it from
+// the others, forget its heading offset) is a FaultActions the navigator's parts take after
+// each hook.
 // FaultMonitor (fault_monitor.hpp) keeps the health state machine and the report.
 #pragma once
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +33,32 @@
 #include "wheelins/fusion/output.hpp"
 
 namespace wheelins {
+
+/// What the fault policy decided be done to the modules. The policy changes nothing but its
+/// own bookkeeping (the health states, the counters); the navigator's parts act on these
+/// after each hook (AidContext::act_on_faults).
+struct FaultActions {
+  /// A module re-initialised from the vehicle: its sensor-error estimates set back to
+  /// `errors` first when `revert_errors` (those learnt while a fault went undetected), then
+  /// levelled by the specific force `f_now` and placed at `fix`.
+  struct Restart {
+    int module = -1;
+    bool revert_errors = false;
+    ImuErrors errors;
+    Vec3 f_now = Vec3::Zero();
+    VehicleFix fix;
+  };
+  std::optional<Restart> restart;
+  /// The output fusion's heading offset of these modules is not to be trusted (it was tracked
+  /// while a fault went undetected).
+  std::array<bool, kMaxModules> forget_heading_offset{};
+  bool any() const {
+    if (restart) return true;
+    for (bool f : forget_heading_offset)
+      if (f) return true;
+    return false;
+  }
+};
 
 class FaultHandler {
  public:
@@ -42,6 +71,13 @@ class FaultHandler {
   bool tied(int i) const { return monitor_.tied(i); }
   /// Health, counters and the report of detected faults.
   const FaultMonitor& monitor() const { return monitor_; }
+  /// What the hooks since the last call decided be done (then cleared).
+  FaultActions take_actions() {
+    FaultActions a = actions_;
+    actions_ = FaultActions{};
+    return a;
+  }
+  bool actions_pending() const { return actions_.any(); }
 
   /// Navigation starts at t0 (every subsystem aligned).
   virtual void on_start(double /*t0*/) {}
@@ -90,6 +126,7 @@ class FaultHandler {
   explicit FaultHandler(FaultMonitor monitor)
       : monitor_(std::move(monitor)), evidence_(static_cast<std::size_t>(monitor_.size())) {}
   FaultMonitor monitor_;
+  FaultActions actions_;  ///< decided, not yet taken
 
  private:
   struct Evidence {
@@ -109,9 +146,10 @@ class NoFaultHandling final : public FaultHandler {
 /// The fault policy of docs/faults.md.
 class FaultPolicy final : public FaultHandler {
  public:
-  /// `subs`, `filter` and `output` are the navigator's; they must outlive the policy.
-  FaultPolicy(const FaultOptions& options, Subsystems& subs, FilterBackend& filter,
-              OutputFusion& output);
+  /// `subs`, `filter` and `output` are the navigator's (read, never changed: the policy's
+  /// decisions are its FaultActions); they must outlive the policy.
+  FaultPolicy(const FaultOptions& options, const Subsystems& subs, const FilterBackend& filter,
+              const OutputFusion& output);
 
   void on_start(double t0) override;
   bool on_sample(int i, const ImuSample& raw, ImuSample& b) override;
@@ -155,12 +193,13 @@ class FaultPolicy final : public FaultHandler {
   void begin_realign(int i, double t, const std::string& what, const std::string& action);
   /// Where module i restarts at time t: the others' fused solution (or its own, alone).
   VehicleFix vehicle_fix(int i, double t) const;
+  /// Module i restarts at time t (decided: actions_.restart; the health state changes now).
   void restart(int i, double t);
 
   FaultOptions opt_;
-  Subsystems& subs_;
-  FilterBackend& filter_;
-  OutputFusion& output_;
+  const Subsystems& subs_;
+  const FilterBackend& filter_;
+  const OutputFusion& output_;
   std::vector<Runtime> rt_;
   bool degraded_ = false;  ///< every wheel saturated or recovering: nobody is blamed
   double direction_t_ = -1e300;  ///< the last direction check
@@ -168,7 +207,7 @@ class FaultPolicy final : public FaultHandler {
 };
 
 /// FaultPolicy when options.enabled, else NoFaultHandling.
-std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, Subsystems& subs,
-                                                 FilterBackend& filter, OutputFusion& output);
+std::unique_ptr<FaultHandler> make_fault_handler(const FaultOptions& options, const Subsystems& subs,
+                                                 const FilterBackend& filter, const OutputFusion& output);
 
 }  // namespace wheelins

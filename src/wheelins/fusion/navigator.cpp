@@ -48,7 +48,7 @@ Navigator::Navigator(const VehicleSetup& setup, const std::vector<std::string>& 
       output_(subs_, *filter_, frame_, opt_, std::move(sink)),
       faults_(make_fault_handler(opt_.faults, subs_, *filter_, output_)),
       noise_(opt_.noise, subs_, opt_.wheel.velocity_update_interval),
-      ctx_{opt_, subs_, *filter_, *faults_, noise_, shared_, meas_},
+      ctx_{opt_, subs_, *filter_, *faults_, output_, noise_, shared_, meas_},
       velocity_(ctx_),
       zero_motion_(ctx_),
       position_(ctx_) {
@@ -83,7 +83,9 @@ void Navigator::process(int index, const ImuSample& raw) {
     }
     start_navigation(static_end_);
   }
-  if (!faults_->on_sample(index, raw, b)) return;
+  const bool navigate = faults_->on_sample(index, raw, b);
+  ctx_.act_on_faults();
+  if (!navigate) return;
   // A steered wheel's start takes the vehicle's heading from an IMU that does not steer.
   if (s.is_wheel() && !subs_.wheel(index).steering_settled())
     subs_.wheel(index).set_reference_heading(unsteered_heading(index));

@@ -5,8 +5,9 @@
 //   zero_motion/          zero velocity and angular rate while the vehicle stands
 //   position_constraint/  the position constraint among the IMUs (eq. 7, 8, 11)
 // The navigator reads as: propagate every sample -> each aid steps when due -> output.
-// The fault policy decides (in_use / counted / tied, the speeds a step may use) and is told
-// of each fusion's report; the aids act on those decisions. The gate itself (the test ratio
+// The fault policy decides (in_use / counted / tied, the speeds a step may use, a module's
+// restart) and is told of each fusion's report; the aids and the navigator act on those
+// decisions (AidContext::act_on_faults). The gate itself (the test ratio
 // against the innovation gate) is the filter's (filter/ekf_update.hpp); an aid counts it.
 #pragma once
 
@@ -21,6 +22,7 @@
 #include "wheelins/fusion/measurement.hpp"
 #include "wheelins/fusion/noise_adaptation.hpp"
 #include "wheelins/fusion/options.hpp"
+#include "wheelins/fusion/output.hpp"
 #include "wheelins/fusion/subsystems.hpp"
 
 namespace wheelins {
@@ -64,6 +66,7 @@ struct AidContext {
   Subsystems& subs;
   FilterBackend& filter;
   FaultHandler& faults;
+  OutputFusion& output;
   NoiseAdaptation& noise;
   SharedInputs& shared;  ///< scratch of the steps (no allocation per epoch)
   Measurement& meas;     ///< scratch of the steps
@@ -96,6 +99,10 @@ struct AidContext {
   }
   /// The Body-INS's current roll/pitch to every Wheel-INS (when shared).
   void share_level() const;
+  /// Takes what the fault policy decided at its last hooks (FaultActions): a module's heading
+  /// offset forgotten, a module restarted from the vehicle (its subsystem and its filter).
+  /// Called after every hook that may decide.
+  void act_on_faults() const;
 };
 
 }  // namespace wheelins

@@ -25,6 +25,7 @@ void PositionConstraintAid::step() {
   const bool have_ref = reference_weights(sh.k, n_ref, n_tied);
   // (The time of each is taken when it is asked: the fault policy may take a module in or out.)
   ctx_.faults.on_position_step(ctx_.min_time());
+  ctx_.act_on_faults();
   if (have_ref) weights_.record(ctx_.min_time(), sh.k);
   if (!have_ref || n_tied < 2) return;
   // Distributed: every subsystem's o at the level the Wheel-INSs were last given; centralized:

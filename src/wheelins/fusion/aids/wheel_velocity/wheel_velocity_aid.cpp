@@ -5,6 +5,7 @@ namespace wheelins {
 
 void WheelVelocityAid::begin_epoch(double t) {
   ctx_.faults.on_velocity_step(t);
+  ctx_.act_on_faults();
   // Shared information (Section III): the vehicle level from the Body-INS, the wheel speed.
   ctx_.share_level();
 }
@@ -36,6 +37,7 @@ void WheelVelocityAid::step(double t) {
     ctx_.noise.after_velocity(i, ctx_.meas, rep, bias_before, t);
     stats_.count(rep);
     ctx_.faults.on_velocity_update(i, rep, t);
+    ctx_.act_on_faults();
   }
 }
 
@@ -47,6 +49,7 @@ void WheelVelocityAid::select_speeds(double t) {
   sel = SpeedSelection();
   for (int i = 0; i < subs.size(); ++i) sel.speed_ok[i] = subs.is_wheel(i) && faults.in_use(i);
   ctx_.faults.screen_speeds(t, ctx_.shared.wheel, sel);
+  ctx_.act_on_faults();
   // The mean is over the usable speeds of the wheels that count; with none, the clipped
   // speeds of saturated wheels (lower bounds) are better than none.
   for (int i = 0; i < subs.size(); ++i)
