@@ -65,7 +65,7 @@ int run(const Options& o) {
   std::unique_ptr<eval::RunEvaluation> evaluation;
   if (m.truth_file)
     evaluation = std::make_unique<eval::RunEvaluation>(m.resolve(*m.truth_file), m.origin,
-                                                       run_evaluation_options(m, o.align_start, o.antenna));
+                                                       run_evaluation_options(m, RunEvaluationRequest{o.align_start, o.antenna, false, ""}));
   req.on_record = [&](const TrajectoryRecord& r) {
     for (auto& w : writers) w->write(r);
     if (evaluation) evaluation->add(r);

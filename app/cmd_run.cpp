@@ -179,17 +179,10 @@ int run(const RunArgs& a) {
   RunRequest req = make_run_request(cfg, warn);
   req.progress = !a.quiet;
 
-  // Evaluation against the truth as the run goes (eval/run_evaluation.hpp): a truth file
-  // that cannot be opened stops the command before the run; a bad record met later is
-  // reported after the trajectory is written.
-  const bool evaluate = req.manifest.truth_file && !a.no_evaluate;
-  std::unique_ptr<eval::RunEvaluation> evaluation;
-  if (evaluate) {
-    evaluation = std::make_unique<eval::RunEvaluation>(req.manifest.resolve(*req.manifest.truth_file),
-                                                       req.manifest.origin,
-                                                       run_evaluation_options(req.manifest, a.align_start, a.antenna));
-    req.on_record = [&](const TrajectoryRecord& r) { evaluation->add(r); };
-  }
+  // Evaluation against the truth as the run goes (run/evaluation.hpp): a truth file that
+  // cannot be opened stops the command before the run; a bad record met later is reported
+  // after the trajectory is written.
+  if (!a.no_evaluate) req.evaluation = RunEvaluationRequest{a.align_start, a.antenna, false, ""};
 
   std::cout << "wheelins run: " << cfg.configuration << " [";
   for (std::size_t i = 0; i < req.modules.size(); ++i) std::cout << (i ? ", " : "") << req.modules[i];
@@ -204,16 +197,10 @@ int run(const RunArgs& a) {
     print_run_details(req, res);
   else
     print_run_summary(req, res);
-  if (evaluate) {
-    eval::EvalResult e;
-    try {
-      e = evaluation->finish();
-    } catch (const InputError& err) {
-      throw InputError(std::string(err.what()) + " (the trajectory was written)");
-    }
-    print_evaluation(e, evaluation->truth().file().string(), res.stats.t_start, res.stats.t_end,
+  if (res.evaluation)
+    print_evaluation(*res.evaluation, res.truth_file.string(), res.stats.t_start, res.stats.t_end,
                      req.modules.size() > 1 && !req.nav.fusion.centralized);
-  }
+  if (!res.evaluation_error.empty()) throw InputError(res.evaluation_error);
   return 0;
 }
 

@@ -262,22 +262,12 @@ RunOutput run(const py::object& manifest, const std::string& configuration, cons
   o.modules = req.modules;
   o.manifest = req.manifest.path.string();
   o.origin_deg = {req.manifest.origin.lat / kDeg, req.manifest.origin.lon / kDeg, req.manifest.origin.h};
-  std::unique_ptr<eval::RunEvaluation> evaluation;
-  if (evaluate && req.manifest.truth_file)
-    evaluation = std::make_unique<eval::RunEvaluation>(req.manifest.resolve(*req.manifest.truth_file),
-                                                       req.manifest.origin);
-  req.on_record = [&](const TrajectoryRecord& r) {
-    o.records.push_back(r);
-    if (evaluation) evaluation->add(r);
-  };
+  // The evaluation `wheelins run` makes, with the same settings (run/evaluation.hpp).
+  if (evaluate) req.evaluation = RunEvaluationRequest{};
+  req.on_record = [&](const TrajectoryRecord& r) { o.records.push_back(r); };
   const RunResult res = interruptible([&] { return run_navigation(req); });
-  if (evaluation) {
-    try {
-      o.metrics_json = eval::to_json(evaluation->finish());
-    } catch (const InputError& e) {
-      throw InputError(std::string(e.what()) + (req.output_dir.empty() ? "" : " (the trajectory was written)"));
-    }
-  }
+  if (!res.evaluation_error.empty()) throw InputError(res.evaluation_error);
+  if (res.evaluation) o.metrics_json = eval::to_json(*res.evaluation);
   o.stats = res.stats;
   o.fault_report = res.fault_report;
   o.noise_report = res.noise_report;

@@ -16,6 +16,8 @@
 #include "io_test_util.hpp"
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/manifest.hpp"
+#include "wheelins/eval/run_evaluation.hpp"
+#include "wheelins/run/evaluation.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/push_session.hpp"
 #include "wheelins/run/run.hpp"
@@ -149,6 +151,45 @@ TEST_F(RunSessionTest, AWarmUpEstimatesTheInstallationAndTheRunWritesIt) {
     const std::string yaml = iotest::read_text_file(out / "calibration.yaml");
     for (const auto& m : r.modules) EXPECT_HAS(yaml, m);
   }
+}
+
+TEST_F(RunSessionTest, TheRunsEvaluationIsTheOneEveryFrontEndGets) {
+  // The session evaluates the vehicle solution with the manifest's settings: the same figures
+  // as an evaluation made by hand from the records with run_evaluation_options().
+  RunRequest r = request("body-wheel", "");
+  r.evaluation = RunEvaluationRequest{};
+  const eval::RunEvaluationOptions eo = run_evaluation_options(r.manifest, *r.evaluation);
+  ASSERT_TRUE(r.manifest.truth_file.has_value());
+  eval::RunEvaluation by_hand(r.manifest.resolve(*r.manifest.truth_file), r.manifest.origin, eo);
+  r.on_record = [&](const TrajectoryRecord& rec) { by_hand.add(rec); };
+  const RunResult res = run_navigation(r);
+  ASSERT_TRUE(res.evaluation.has_value()) << res.evaluation_error;
+  const eval::EvalResult e = by_hand.finish();
+  EXPECT_GT(res.evaluation->distance, 10.0);  // (too short a run for a drift rate: no segment)
+  EXPECT_EQ(res.evaluation->epochs, e.epochs);
+  EXPECT_EQ(res.evaluation->heading_rmse, e.heading_rmse);
+  EXPECT_EQ(res.evaluation->final_error, e.final_error);
+  EXPECT_EQ(res.truth_file, r.manifest.resolve(*r.manifest.truth_file));
+
+  // The settings: a local frame (no initial heading) is aligned over 100 m unless told.
+  Manifest m = r.manifest;
+  m.heading_known = true;
+  EXPECT_EQ(run_evaluation_options(m, {}).eval.align_start, 0.0);
+  m.heading_known = false;
+  EXPECT_EQ(run_evaluation_options(m, {}).eval.align_start, kDefaultAlignStart);
+  EXPECT_EQ(run_evaluation_options(m, RunEvaluationRequest{5.0, "", false, ""}).eval.align_start, 5.0);
+  EXPECT_EQ(run_evaluation_options(m, RunEvaluationRequest{{}, "0.5,0,-1.2", false, ""}).eval.antenna,
+            Vec3(0.5, 0.0, -1.2));
+  EXPECT_HAS(iotest::error_of([&] { run_evaluation_options(m, RunEvaluationRequest{{}, "1,2", false, ""}); }),
+             "--antenna '1,2': expected X,Y,Z");
+
+  // A truth file that cannot be read stops the run before any work: no output directory.
+  const fs::path out = dir_->path() / "no-truth";
+  RunRequest bad = request("body-wheel", out);
+  bad.evaluation = RunEvaluationRequest{};
+  bad.manifest.truth_file = "missing-truth.txt";
+  EXPECT_HAS(iotest::error_of([&] { run_navigation(bad); }), "missing-truth.txt");
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/io/trajectory.hpp"
 #include "wheelins/run/calibration.hpp"
+#include "wheelins/run/evaluation.hpp"
 
 namespace wheelins {
 
@@ -41,7 +43,11 @@ struct RunRequest {
   /// manifest as it is.
   bool data_checks = true;
   WarningSink warn;
-  /// Called for every vehicle record (e.g. to evaluate in memory); may be empty.
+  /// The vehicle solution evaluated against the manifest's truth as the run goes (when the
+  /// manifest has one): a truth file that cannot be read stops the run before any work; a
+  /// bad record met later is RunResult::evaluation_error, the trajectory written.
+  std::optional<RunEvaluationRequest> evaluation;
+  /// Called for every vehicle record (e.g. to keep them in memory); may be empty.
   std::function<void(const TrajectoryRecord&)> on_record;
 };
 
@@ -59,6 +65,11 @@ struct RunResult {
   std::string weights_report;                ///< readable summary of them (multi-IMU runs)
   InstallationCalibration calibration;  ///< the installation estimates (calibration.yaml)
   std::string calibration_report;            ///< readable table of them (empty: not estimated)
+  /// Against the truth (RunRequest::evaluation): the figures, the truth file, or why the
+  /// evaluation failed after the run (the files are written either way).
+  std::optional<eval::EvalResult> evaluation;
+  std::filesystem::path truth_file;
+  std::string evaluation_error;
 };
 
 /// Runs the request on the manifest's files (a RunSession fed by them, session.hpp). The

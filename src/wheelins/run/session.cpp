@@ -42,6 +42,11 @@ bool FileThinning::keep(const TrajectoryRecord& rec) {
 RunSession::RunSession(RunRequest request, const InstallationCalibration* calibration)
     : wall0_(std::chrono::steady_clock::now()), req_(std::move(request)) {
   validate_run_request(req_);
+  // The truth is opened first: a file that cannot be read stops the run before any work.
+  if (req_.evaluation && req_.manifest.truth_file)
+    evaluation_ = std::make_unique<eval::RunEvaluation>(req_.manifest.resolve(*req_.manifest.truth_file),
+                                                        req_.manifest.origin,
+                                                        run_evaluation_options(req_.manifest, *req_.evaluation));
   stage_outputs();
   if (req_.data_checks) check_manifest_against_data(req_.manifest, req_.modules, req_.warn);
   if (req_.calibration == CalibrationMode::kEstimate) {
@@ -124,6 +129,7 @@ void RunSession::on_record(int stream, const TrajectoryRecord& rec) {
     return;
   }
   const auto t0 = std::chrono::steady_clock::now();
+  if (stream == 0 && evaluation_) evaluation_->add(rec);
   if (stream == 0 && req_.on_record) req_.on_record(rec);
   if (pipe_ && thinning_[static_cast<std::size_t>(stream)].keep(rec)) pipe_->push(stream, rec);
   sink_seconds_ += seconds_since(t0);
@@ -243,8 +249,19 @@ RunResult RunSession::finish(double process_seconds, const std::vector<SessionIn
   for (auto& f : result.files) f = out_dir_ ? out_dir_->final_path(f.filename()) : f;
   result.stats = nav_->stats();
   result.filter_seconds = std::max(0.0, process_seconds - sink_seconds_);
+  finish_evaluation(result);
   result.wall_seconds = seconds_since(wall0_);
   return result;
+}
+
+void RunSession::finish_evaluation(RunResult& result) {
+  if (!evaluation_) return;
+  result.truth_file = evaluation_->truth().file();
+  try {
+    result.evaluation = evaluation_->finish();
+  } catch (const InputError& e) {
+    result.evaluation_error = std::string(e.what()) + (req_.output_dir.empty() ? "" : " (the trajectory was written)");
+  }
 }
 
 }  // namespace wheelins

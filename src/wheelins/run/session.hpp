@@ -83,6 +83,7 @@ class RunSession {
   void on_record(int stream, const TrajectoryRecord& rec);
   void write_reports(const std::string& input_csv, const std::vector<ModuleNoiseReport>& noise);
   void require_navigating(const std::vector<SessionInput>& inputs) const;
+  void finish_evaluation(RunResult& result);
 
   std::chrono::steady_clock::time_point wall0_;
   RunRequest req_;
@@ -98,6 +99,7 @@ class RunSession {
   int bad_stream_ = -1;
   double bad_t_ = 0.0;
   std::unique_ptr<Navigator> nav_;
+  std::unique_ptr<eval::RunEvaluation> evaluation_;  ///< RunRequest::evaluation
 };
 
 }  // namespace wheelins

@@ -304,16 +304,14 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     tm.generated = data.generated;
     t = std::chrono::steady_clock::now();
     RunRequest req = job_request(s, j, o, data, who, warnings);
-    // The evaluation `wheelins run` makes (eval/run_evaluation.hpp): the truth streamed in step
+    // The evaluation `wheelins run` makes (run/evaluation.hpp): the truth streamed in step
     // with the run, so memory stays flat however long the data.
-    eval::RunEvaluationOptions eo;
-    eo.keep_series = j.keep_series;
-    eo.solution = "the vehicle solution of " + who;
-    eval::RunEvaluation ev(req.manifest.resolve(*req.manifest.truth_file), req.manifest.origin, eo);
+    if (!req.manifest.truth_file)
+      throw InputError("'" + req.manifest.path.string() + "': no truth file: a study's job is evaluated against it");
+    req.evaluation = RunEvaluationRequest{std::nullopt, "", j.keep_series, "the vehicle solution of " + who};
     std::vector<TrajectoryRecord> track;
     std::size_t records = 0;
     req.on_record = [&](const TrajectoryRecord& r) {
-      ev.add(r);
       if (j.keep_series && records % 20 == 0) track.push_back(r);  // 1 Hz of the 20 Hz records
       ++records;
     };
@@ -323,7 +321,8 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     tm.navigate = since(t);
     tm.filter = rr.filter_seconds;
     t = std::chrono::steady_clock::now();
-    eval::EvalResult e = ev.finish();
+    if (!rr.evaluation_error.empty()) throw InputError(rr.evaluation_error);
+    eval::EvalResult e = *rr.evaluation;
     std::vector<std::pair<fs::path, std::string>> side;
     if (j.keep_series) {
       std::vector<eval::EpochError> kept;  // 10 Hz of the 200 Hz truth epochs
