@@ -51,19 +51,6 @@ struct RunArgs {
   std::vector<std::string> settings;  ///< --set KEY=VALUE, any key of docs/run-config.md
 };
 
-/// A command-line number in its range [lo, hi] (NaN, infinities and 1e400 fail too).
-void check_range(const std::optional<double>& v, const char* option, double lo, double hi,
-                 const char* unit, bool lo_open = false) {
-  if (!v) return;
-  const double x = *v;
-  if (!std::isfinite(x) || x < lo || x > hi || (lo_open && x == lo)) {
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "%s %g: must be in %s%g, %g] %s", option, x, lo_open ? "(" : "[",
-                  lo, hi, unit);
-    throw InputError(buf);
-  }
-}
-
 /// The statistics of the run every summary starts with: time, updates, covariance checks.
 void print_run_statistics(const RunResult& res) {
   const NavigatorStats& st = res.stats;
@@ -167,15 +154,9 @@ RunOverrides overrides_of(const RunArgs& a) {
 }
 
 int run(const RunArgs& a) {
-  check_range(a.duration, "--duration", 0.0, 1e7, "s", true);
-  for (const auto& [value, option, key] : {std::tuple{&a.output_interval, "--output-interval", "output.interval_s"},
-                                           std::tuple{&a.covariance_interval, "--covariance-interval",
-                                                      "filter.covariance_interval_s"}}) {
-    const OptionRange r = run_option_range(key);
-    check_range(*value, option, r.lo, r.hi, r.unit);
-  }
+  const RunOverrides overrides = overrides_of(a);
   const WarningSink warn = stderr_sink();  // one sink: each warning once
-  const RunConfig cfg = run_config_with(overrides_of(a), warn);
+  const RunConfig cfg = run_config_with(overrides, warn);
   RunRequest req = make_run_request(cfg, warn);
   req.progress = !a.quiet;
 

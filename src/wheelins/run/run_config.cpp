@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
+#include <tuple>
 
 #include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/run/presets.hpp"
@@ -275,7 +278,36 @@ RunConfig load_run_config(const YAML::Node& settings, const fs::path& base, cons
   return read_run_config(y, base);
 }
 
+namespace {
+
+/// A front end's number (its command-line option `option`) in its range [lo, hi] (NaN,
+/// infinities and 1e400 fail too); `lo_open`: lo itself excluded.
+void check_range(const std::optional<double>& v, const char* option, double lo, double hi, const char* unit,
+                 bool lo_open = false) {
+  if (!v) return;
+  const double x = *v;
+  if (!std::isfinite(x) || x < lo || x > hi || (lo_open && x == lo)) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%s %g: must be in %s%g, %g] %s", option, x, lo_open ? "(" : "[", lo, hi, unit);
+    throw InputError(buf);
+  }
+}
+
+/// The numbers a front end gives over the file, in the ranges the file's keys have.
+void check_override_numbers(const RunOverrides& o) {
+  check_range(o.duration, "--duration", 0.0, 1e7, "s", true);
+  for (const auto& [value, option, key] :
+       {std::tuple{&o.output_interval, "--output-interval", "output.interval_s"},
+        std::tuple{&o.covariance_interval, "--covariance-interval", "filter.covariance_interval_s"}}) {
+    const OptionRange r = run_option_range(key);
+    check_range(*value, option, r.lo, r.hi, r.unit);
+  }
+}
+
+}  // namespace
+
 RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
+  check_override_numbers(o);
   RunConfig cfg = o.config.empty() ? RunConfig{} : load_run_config(o.config, warn);
   apply_run_settings(o.settings, cfg);
   if (!o.manifest.empty()) cfg.manifest = o.manifest;
