@@ -1,12 +1,10 @@
 // `wheelins run`: navigate one configuration of a dataset and write its trajectory.
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
-#include <tuple>
 
 #include "cli.hpp"
 #include "run_report.hpp"

@@ -67,6 +67,9 @@ class Navigator {
   bool navigating() const { return navigating_; }
   /// The counters, the aids' included.
   const NavigatorStats& stats() const;
+  /// When navigation started [s] (stats().t_start without composing the aids' counters:
+  /// for the per-sample checks).
+  double start_time() const { return stats_.t_start; }
   int subsystem_count() const { return subs_.size(); }
   const Subsystem& subsystem(int i) const { return subs_.at(i); }
   Subsystem& subsystem(int i) { return subs_.at(i); }

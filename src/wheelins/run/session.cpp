@@ -144,7 +144,7 @@ bool RunSession::push(int module, const ImuSample& s, std::uint64_t record) {
                      ", 0-based, is the first after the gap); nothing was written. Cut the data at the "
                      "gap and run the parts apart, or raise faults.max_outage_s");
   }
-  return !(req_.max_duration > 0 && nav_->navigating() && s.t - nav_->stats().t_start >= req_.max_duration);
+  return !(req_.max_duration > 0 && nav_->navigating() && s.t - nav_->start_time() >= req_.max_duration);
 }
 
 // Where the solution stopped being finite: the first subsystem whose state or covariance is
@@ -167,7 +167,7 @@ void RunSession::check_finite(double t_now) const {
   }
   const double t = bad_stream_ >= 0 ? bad_t_ : t_now;
   char after[32];
-  std::snprintf(after, sizeof after, "%.1f", t - nav_->stats().t_start);
+  std::snprintf(after, sizeof after, "%.1f", t - nav_->start_time());
   throw InputError("'" + module + "': the navigation became non-finite (" + cause + ") by t = " + format_double(t) +
                    " s, " + after +
                    " s after the start: the filter diverged (an input or a setting outside what "

@@ -306,8 +306,6 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     RunRequest req = job_request(s, j, o, data, who, warnings);
     // The evaluation `wheelins run` makes (run/evaluation.hpp): the truth streamed in step
     // with the run, so memory stays flat however long the data.
-    if (!req.manifest.truth_file)
-      throw InputError("'" + req.manifest.path.string() + "': no truth file: a study's job is evaluated against it");
     req.evaluation = RunEvaluationRequest{std::nullopt, "", j.keep_series, "the vehicle solution of " + who};
     std::vector<TrajectoryRecord> track;
     std::size_t records = 0;
@@ -322,7 +320,7 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     tm.filter = rr.filter_seconds;
     t = std::chrono::steady_clock::now();
     if (!rr.evaluation_error.empty()) throw InputError(rr.evaluation_error);
-    eval::EvalResult e = *rr.evaluation;
+    eval::EvalResult e = rr.evaluation.value();  // job_request made sure of the truth file
     std::vector<std::pair<fs::path, std::string>> side;
     if (j.keep_series) {
       std::vector<eval::EpochError> kept;  // 10 Hz of the 200 Hz truth epochs
