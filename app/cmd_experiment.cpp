@@ -69,7 +69,7 @@ int prepare_study(const fs::path& final_out, const std::string& text, bool force
                      "directory");
   }
   fs::create_directories(final_out);
-  if (existing != text) study::write_file_atomic(study_file, text);
+  if (existing != text) write_file_atomic(study_file, text, study::shared_file(study_file));
   const study::Study s = study::Study::load(study_file);
   std::cout << "wrote " << study_file.string() << ": " << s.job_count() << " runs (jobs 0.." << s.job_count() - 1
             << "); run them with `wheelins study run " << study_file.string()
@@ -134,7 +134,7 @@ int run(const Args& a) {
   out_opt.notice = stderr_sink();
   OutputDir out_dir(final_out, out_opt);
   const fs::path out = out_dir.staging();
-  study::write_file_atomic(out / "study.yaml", text);
+  write_file_atomic(out / "study.yaml", text, study::shared_file(out / "study.yaml"));
   const study::Study s = study::Study::load(out / "study.yaml");
   run_all_jobs(s, a);
 

@@ -2,6 +2,9 @@
 // overwrite; the fast fixed-notation number writer.
 #include "wheelins/io/atomic_file.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -182,26 +185,81 @@ void append_fixed(std::string& out, double value, int decimals) {
   out.append(buf, res.ptr);
 }
 
-AtomicTextFile::AtomicTextFile(const std::filesystem::path& file, bool overwrite)
-    : file_(file), tmp_(io_detail::unique_partial(file)), overwrite_(overwrite) {
-  check_output_target(file, overwrite);
+AtomicFile::AtomicFile(const std::filesystem::path& file, const AtomicFileOptions& options)
+    : file_(file),
+      tmp_(options.temporary.empty() ? io_detail::unique_partial(file) : options.temporary),
+      overwrite_(options.overwrite) {
+  check_output_target(file, overwrite_);
   if (file.has_parent_path()) {
     std::error_code ec;
     std::filesystem::create_directories(file.parent_path(), ec);
     if (ec)
       throw InputError(quote(file.parent_path()) + ": cannot create directory: " + ec.message());
   }
-  fp_ = std::fopen(tmp_.c_str(), "wb");
-  if (!fp_) throw InputError(quote(tmp_) + ": cannot create: " + std::strerror(errno));
-  buf_.reserve(kFlushBytes + 4096);
+  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd_ < 0) throw InputError(quote(tmp_) + ": cannot create: " + std::strerror(errno));
 }
 
-AtomicTextFile::~AtomicTextFile() {
-  if (fp_) std::fclose(fp_);
+AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
   if (!committed_) {
     std::error_code ec;
     std::filesystem::remove(tmp_, ec);
   }
+}
+
+void AtomicFile::write(const void* data, std::size_t bytes) {
+  const char* p = static_cast<const char*>(data);
+  while (bytes > 0) {
+    const ssize_t n = ::write(fd_, p, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw InputError(quote(file_) + ": write failed: " + std::strerror(n < 0 ? errno : ENOSPC));
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
+  }
+}
+
+void AtomicFile::commit() {
+  if (committed_) return;
+  const int rc = ::close(fd_);
+  fd_ = -1;
+  if (rc != 0) throw InputError(quote(file_) + ": close failed: " + std::strerror(errno));
+  move_into_place(tmp_, file_, overwrite_);
+  committed_ = true;
+}
+
+void move_into_place(const std::filesystem::path& temporary, const std::filesystem::path& file,
+                     bool overwrite) {
+  std::error_code ec;
+  try {
+    check_output_target(file, overwrite);  // the target may have appeared since the writer looked
+  } catch (...) {
+    std::filesystem::remove(temporary, ec);
+    throw;
+  }
+  std::filesystem::rename(temporary, file, ec);
+  if (ec) {
+    std::error_code ec2;
+    std::filesystem::remove(temporary, ec2);
+    throw InputError(quote(file) + ": cannot move the finished file into place: " + ec.message());
+  }
+}
+
+void write_file_atomic(const std::filesystem::path& file, std::string_view text,
+                       const AtomicFileOptions& options, const ChunkWriter& write_chunk) {
+  AtomicFile out(file, options);
+  constexpr std::size_t kChunk = 1 << 16;
+  for (std::size_t pos = 0; pos < text.size(); pos += kChunk) {
+    const std::string_view chunk = text.substr(pos, kChunk);
+    if (write_chunk) write_chunk(out.fd(), chunk);
+    else out.write(chunk);
+  }
+  out.commit();
+}
+
+AtomicTextFile::AtomicTextFile(const std::filesystem::path& file, bool overwrite)
+    : out_(file, AtomicFileOptions{overwrite, {}}) {
+  buf_.reserve(kFlushBytes + 4096);
 }
 
 void AtomicTextFile::write(std::string_view text) {
@@ -215,23 +273,14 @@ void AtomicTextFile::maybe_flush() {
 
 void AtomicTextFile::flush() {
   if (buf_.empty()) return;
-  if (std::fwrite(buf_.data(), 1, buf_.size(), fp_) != buf_.size())
-    throw InputError(quote(tmp_) + ": write failed: " + std::strerror(errno));
+  out_.write(buf_);
   buf_.clear();
 }
 
 void AtomicTextFile::commit() {
-  if (committed_) return;
+  if (out_.committed()) return;
   flush();
-  const int rc = std::fclose(fp_);
-  fp_ = nullptr;
-  if (rc != 0) throw InputError(quote(tmp_) + ": close failed: " + std::strerror(errno));
-  // The target may have appeared since the constructor looked.
-  check_output_target(file_, overwrite_);
-  std::error_code ec;
-  std::filesystem::rename(tmp_, file_, ec);
-  if (ec) throw InputError(quote(file_) + ": cannot move the finished file into place: " + ec.message());
-  committed_ = true;
+  out_.commit();
 }
 
 }  // namespace wheelins

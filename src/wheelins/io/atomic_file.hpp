@@ -1,10 +1,12 @@
 // Output files that appear complete or not at all: written under a temporary
-// name (`file.partial`) and moved into place by commit(). An existing file is
-// replaced only when the caller asked for it (`overwrite`).
+// name (`file.partial-PID-N`) and moved into place by commit(). An existing file is
+// replaced only when the caller asked for it (`overwrite`). Every file wheelins writes
+// whole goes through AtomicFile (text, binary rows, manifests, study results); a rendered
+// image through move_into_place().
 #pragma once
 
-#include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,14 +48,64 @@ char* write_double(char* dst, double value, int significant = 0);
 /// Appends `value` with a fixed number of decimals (e.g. degrees in KML).
 void append_fixed(std::string& out, double value, int decimals);
 
-/// A buffered text file written through `file.partial`; commit() renames it into
-/// place. Without commit() (an exception part-way) the partial file is removed.
+/// Writes the bytes of one chunk to `fd` (a temporary file); throws on failure. Tests put a
+/// failing one in to see that nothing half-written is left.
+using ChunkWriter = std::function<void(int fd, std::string_view chunk)>;
+
+/// How an AtomicFile replaces and where it writes meanwhile.
+struct AtomicFileOptions {
+  /// false: an existing `file` is refused (check_output_target), when the writer opens and
+  /// again when it commits; true: the finished file replaces it.
+  bool overwrite = true;
+  /// The temporary name; empty: unique_partial(file) (`file.partial-PID-N`, which
+  /// sweep_stale_partials() clears after a killed writer).
+  std::filesystem::path temporary;
+};
+
+/// The one writer of a file that appears complete or not at all: the bytes go to a
+/// temporary beside it (created exclusively: two writers never share one), commit() renames
+/// it over `file` (readers see the old file or the new one, never a part); destroyed without
+/// commit() (an exception part-way), the temporary is removed. The parent directory is
+/// created. There is no fsync: a machine that crashes may lose its latest files (readers
+/// reject a file cut short); a failing process or a full disk leaves nothing behind.
+class AtomicFile {
+ public:
+  AtomicFile(const std::filesystem::path& file, const AtomicFileOptions& options);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  /// Writes all of `bytes` (unbuffered: callers write in large blocks); throws InputError.
+  void write(const void* data, std::size_t bytes);
+  void write(std::string_view text) { write(text.data(), text.size()); }
+  /// The temporary's descriptor (for a ChunkWriter).
+  int fd() const { return fd_; }
+  void commit();
+  bool committed() const { return committed_; }
+  const std::filesystem::path& file() const { return file_; }
+  const std::filesystem::path& temporary() const { return tmp_; }
+
+ private:
+  std::filesystem::path file_, tmp_;
+  bool overwrite_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
+/// Moves the finished `temporary` over `file` by a rename; without `overwrite` an existing
+/// `file` is refused. On failure the temporary is removed and InputError names `file`.
+void move_into_place(const std::filesystem::path& temporary, const std::filesystem::path& file,
+                     bool overwrite);
+
+/// `text` written to `file` through an AtomicFile, in chunks of 64 KiB; `write_chunk`
+/// (tests) replaces the writing of each chunk.
+void write_file_atomic(const std::filesystem::path& file, std::string_view text,
+                       const AtomicFileOptions& options = {}, const ChunkWriter& write_chunk = {});
+
+/// A buffered text file written through an AtomicFile; commit() renames it into place.
 class AtomicTextFile {
  public:
   AtomicTextFile(const std::filesystem::path& file, bool overwrite);
-  ~AtomicTextFile();
-  AtomicTextFile(const AtomicTextFile&) = delete;
-  AtomicTextFile& operator=(const AtomicTextFile&) = delete;
 
   /// Appends text; flushed to disk in large blocks.
   void write(std::string_view text);
@@ -61,16 +113,13 @@ class AtomicTextFile {
   std::string& buffer() { return buf_; }
   void maybe_flush();
   void commit();
-  bool committed() const { return committed_; }
-  const std::filesystem::path& file() const { return file_; }
+  bool committed() const { return out_.committed(); }
+  const std::filesystem::path& file() const { return out_.file(); }
 
  private:
   void flush();
-  std::filesystem::path file_, tmp_;
-  bool overwrite_;
-  std::FILE* fp_ = nullptr;
+  AtomicFile out_;
   std::string buf_;
-  bool committed_ = false;
 };
 
 }  // namespace wheelins

@@ -56,19 +56,8 @@ const double* BinaryRowReader::next() {
 }
 
 BinaryRowWriter::BinaryRowWriter(const std::filesystem::path& file, int ncols)
-    : file_(file), tmp_(io_detail::unique_partial(file)), ncols_(ncols) {
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-  fp_ = std::fopen(tmp_.c_str(), "wb");
-  if (!fp_) throw InputError(quote(tmp_) + ": cannot create: " + std::strerror(errno));
+    : out_(file, AtomicFileOptions{}), ncols_(ncols) {
   block_.reserve(kBlockBytes / sizeof(double));
-}
-
-BinaryRowWriter::~BinaryRowWriter() {
-  if (fp_) std::fclose(fp_);
-  if (!committed_) {
-    std::error_code ec;
-    std::filesystem::remove(tmp_, ec);
-  }
 }
 
 void BinaryRowWriter::write(const double* row) {
@@ -79,20 +68,13 @@ void BinaryRowWriter::write(const double* row) {
 
 void BinaryRowWriter::flush() {
   if (block_.empty()) return;
-  if (std::fwrite(block_.data(), sizeof(double), block_.size(), fp_) != block_.size())
-    throw InputError(quote(tmp_) + ": write failed: " + std::strerror(errno));
+  out_.write(block_.data(), block_.size() * sizeof(double));
   block_.clear();
 }
 
 void BinaryRowWriter::commit() {
   flush();
-  if (std::fclose(fp_) != 0) {
-    fp_ = nullptr;
-    throw InputError(quote(tmp_) + ": close failed: " + std::strerror(errno));
-  }
-  fp_ = nullptr;
-  std::filesystem::rename(tmp_, file_);
-  committed_ = true;
+  out_.commit();
 }
 
 }  // namespace wheelins

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "wheelins/io/atomic_file.hpp"
+
 namespace wheelins {
 
 /// Reads rows of `ncols` float64 values. Rejects (with InputError naming the file
@@ -40,15 +42,12 @@ class BinaryRowReader {
   std::size_t block_rows_ = 0, block_pos_ = 0;
 };
 
-/// Writes rows of `ncols` float64 values to `file` through a temporary name
-/// (`file.partial`); commit() moves it into place. Without commit() (an error
-/// part-way) the partial file is removed and nothing the user had is touched.
+/// Writes rows of `ncols` float64 values to `file` through an AtomicFile; commit() moves it
+/// into place. Without commit() (an error part-way) the partial file is removed and nothing
+/// the user had is touched.
 class BinaryRowWriter {
  public:
   BinaryRowWriter(const std::filesystem::path& file, int ncols);
-  ~BinaryRowWriter();
-  BinaryRowWriter(const BinaryRowWriter&) = delete;
-  BinaryRowWriter& operator=(const BinaryRowWriter&) = delete;
 
   void write(const double* row);
   void commit();
@@ -56,12 +55,10 @@ class BinaryRowWriter {
 
  private:
   void flush();
-  std::filesystem::path file_, tmp_;
+  AtomicFile out_;
   int ncols_;
-  std::FILE* fp_ = nullptr;
   std::vector<double> block_;
   std::uint64_t rows_ = 0;
-  bool committed_ = false;
 };
 
 }  // namespace wheelins

@@ -665,28 +665,7 @@ void save_manifest(const Manifest& m, const fs::path& file, const ManifestAnnota
   if (fs::is_directory(file, ec))
     throw InputError(quote(file) + ": is a directory, expected a manifest file name");
   const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  const std::string text = manifest_to_yaml(m, dir, notes);
-  if (file.has_parent_path()) {
-    fs::create_directories(file.parent_path(), ec);
-    if (ec) throw InputError(quote(file.parent_path()) + ": cannot create directory: " + ec.message());
-  }
-  const fs::path tmp = io_detail::unique_partial(file);
-  {
-    std::FILE* fp = std::fopen(tmp.c_str(), "wb");
-    if (!fp) throw InputError(quote(tmp) + ": cannot create: " + std::strerror(errno));
-    const bool ok = std::fwrite(text.data(), 1, text.size(), fp) == text.size();
-    const int err = errno;
-    if (std::fclose(fp) != 0 || !ok) {
-      fs::remove(tmp, ec);
-      throw InputError(quote(tmp) + ": write failed: " + std::strerror(err));
-    }
-  }
-  fs::rename(tmp, file, ec);
-  if (ec) {
-    std::error_code ec2;
-    fs::remove(tmp, ec2);
-    throw InputError(quote(file) + ": cannot move the finished file into place: " + ec.message());
-  }
+  write_file_atomic(file, manifest_to_yaml(m, dir, notes));
 }
 
 }  // namespace wheelins

@@ -3,7 +3,6 @@
 #include "wheelins/io/output_dir.hpp"
 
 #include <fcntl.h>
-#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -184,15 +183,11 @@ OutputDir::OutputDir(const fs::path& target, const OutputDirOptions& options) : 
   else if (errno != EEXIST)
     throw InputError(q + ": cannot create: " + std::strerror(errno));
   try {
-    lock_fd_ = ::open(target_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (lock_fd_ < 0) throw InputError(q + ": cannot open: " + std::strerror(errno));
-    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-      const int err = errno;
-      if (err == EWOULDBLOCK)
-        throw InputError(q + ": another wheelins command is writing there right now; wait for it "
-                         "to finish or choose another output directory");
-      throw InputError(q + ": cannot lock: " + std::strerror(err));
-    }
+    lock_.emplace(target_, FileLock::Wait::kNo);
+    if (lock_->state() == FileLock::State::kHeldElsewhere)
+      throw InputError(q + ": another wheelins command is writing there right now; wait for it "
+                       "to finish or choose another output directory");
+    if (!lock_->locked()) throw InputError(q + ": cannot lock: " + std::strerror(lock_->error()));
     sweep_stale(parent, name);
     std::string tmpl =
         (parent / ("." + name + ".partial-" + std::to_string(::getpid()) + "-XXXXXX")).string();
@@ -212,8 +207,7 @@ void OutputDir::cleanup() noexcept {
   if (!committed_ && created_target_) ::rmdir(target_.c_str());  // only if still empty
   created_target_ = false;
   staging_.clear();
-  if (lock_fd_ >= 0) ::close(lock_fd_);
-  lock_fd_ = -1;
+  lock_.reset();
 }
 
 OutputDir::~OutputDir() { cleanup(); }
@@ -316,8 +310,7 @@ void OutputDir::commit() {
   }
   committed_ = true;
   staging_.clear();
-  if (lock_fd_ >= 0) ::close(lock_fd_);
-  lock_fd_ = -1;
+  lock_.reset();
 }
 
 }  // namespace wheelins

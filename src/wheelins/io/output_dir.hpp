@@ -21,8 +21,11 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "wheelins/io/file_lock.hpp"
 
 namespace wheelins {
 
@@ -69,7 +72,7 @@ class OutputDir {
   void replace_target(const std::string& quoted);
   std::filesystem::path target_, staging_;
   OutputDirOptions opt_;
-  int lock_fd_ = -1;
+  std::optional<FileLock> lock_;
   bool created_target_ = false;
   bool replace_ = false;
   bool committed_ = false;

@@ -602,8 +602,7 @@ std::vector<fs::path> render_gnuplot(const fs::path& plots, const std::vector<st
              (pr.output.empty() ? std::string() : ": " + first_lines(pr.output, 6)));
       continue;
     }
-    fs::rename(partial, png, ec);
-    if (ec) throw InputError("'" + png.string() + "': cannot move the rendered plot into place: " + ec.message());
+    move_into_place(partial, png, true);
     written.push_back(plots / (name + ".png"));
   }
   return written;

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdlib>
 
+#include "wheelins/io/file_lock.hpp"
 #include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
 #include "wheelins/sim/simulator.hpp"
@@ -131,7 +132,7 @@ fs::path simulated(const DatasetSpec& d, const fs::path& cache, bool& generated)
   fs::create_directories(cache, ec);
   if (ec)
     throw InputError("'" + cache.string() + "': cannot create the dataset cache: " + ec.message());
-  const FileLock lock(cache / (d.cache_name + ".lock"));
+  const FileLock lock(cache / (d.cache_name + ".lock"), FileLock::Wait::kUntilFree);
   if (complete(dir, d.canonical)) return dir;  // made by another process while this one waited
   if (fs::exists(dir, ec)) {
     std::string text;
@@ -150,7 +151,7 @@ fs::path simulated(const DatasetSpec& d, const fs::path& cache, bool& generated)
   try {
     const sim::Simulation simulation(*d.sim);
     simulation.write(tmp, false, false);
-    write_file_atomic(tmp / "settings.txt", d.canonical);
+    write_file_atomic(tmp / "settings.txt", d.canonical, shared_file(tmp / "settings.txt"));
     fs::rename(tmp, dir, ec);
     if (ec) {
       if (!complete(dir, d.canonical))
@@ -197,7 +198,7 @@ PreparedDataset prepare_dataset(const DatasetSpec& d, const fs::path& cache) {
           edit_manifest(text, d.manifest_edits, d.sim ? fs::path() : base_manifest.parent_path(),
                         "'" + base_manifest.string() + "'");
       fs::create_directories(edited.parent_path(), ec);
-      write_file_atomic(edited, out_text);
+      write_file_atomic(edited, out_text, shared_file(edited));
     }
     out.manifest = edited;
   }

@@ -1,15 +1,11 @@
-// Files several processes write at once (files.hpp): results written to a temporary file
-// renamed into place, and the lock file one dataset generator holds.
+// Files several processes write at once (files.hpp): the temporary names of results
+// renamed into place, and the list of a report's files.
 #include "wheelins/study/files.hpp"
 
-#include <fcntl.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
-#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -61,7 +57,7 @@ void ReportFiles::add(const std::vector<fs::path>& rels) {
   }
   std::string text;
   for (const auto& n : names_) text += n + "\n";
-  write_file_atomic(dir_ / kReportList, text);
+  write_file_atomic(dir_ / kReportList, text, shared_file(dir_ / kReportList));
   listed_ = true;
 }
 
@@ -74,62 +70,8 @@ bool read_file(const fs::path& file, std::string& out) {
   return static_cast<bool>(in) || in.eof();
 }
 
-void write_file_atomic(const fs::path& file, std::string_view text,
-                       const ChunkWriter& write_chunk) {
-  const fs::path tmp =
-      file.parent_path() / ("." + file.filename().string() + ".tmp-" + unique_suffix());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) throw InputError("'" + tmp.string() + "': cannot create: " + std::strerror(errno));
-  constexpr std::size_t kChunk = 1 << 16;
-  try {
-    for (std::size_t pos = 0; pos < text.size(); pos += kChunk) {
-      const std::string_view chunk = text.substr(pos, kChunk);
-      if (write_chunk) {
-        write_chunk(fd, chunk);
-        continue;
-      }
-      std::size_t done = 0;
-      while (done < chunk.size()) {
-        const ssize_t n = ::write(fd, chunk.data() + done, chunk.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0)
-          throw InputError("'" + file.string() + "': cannot write: " + std::strerror(errno));
-        done += static_cast<std::size_t>(n);
-      }
-    }
-  } catch (...) {
-    ::close(fd);
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw;
-  }
-  if (::close(fd) != 0) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw InputError("'" + file.string() + "': cannot close: " + std::strerror(errno));
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw InputError("'" + file.string() + "': cannot move into place: " + ec.message());
-  }
-}
-
-FileLock::FileLock(const fs::path& file) {
-  fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd_ < 0)
-    throw InputError("'" + file.string() +
-                     "': cannot create the lock file: " + std::strerror(errno));
-  while (::flock(fd_, LOCK_EX) != 0) {
-    if (errno == EINTR) continue;
-    return;  // no locks on this file system (ENOLCK, EOPNOTSUPP, ...): locked() stays false
-  }
-  locked_ = true;
-}
-
-FileLock::~FileLock() {
-  if (fd_ >= 0) ::close(fd_);  // releases the lock
+AtomicFileOptions shared_file(const fs::path& file) {
+  return {true, file.parent_path() / ("." + file.filename().string() + ".tmp-" + unique_suffix())};
 }
 
 }  // namespace wheelins::study

@@ -4,24 +4,22 @@
 #pragma once
 
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "wheelins/io/atomic_file.hpp"
+
 namespace wheelins::study {
 
-/// Writes the bytes of one chunk to `fd` (the temporary file); throws on failure.
-using ChunkWriter = std::function<void(int fd, std::string_view chunk)>;
-
-/// Writes `text` to `file` through a temporary file of a unique name in the same directory
-/// (`.NAME.tmp-HOST-PID-N`) renamed over `file`: a process killed or failing part-way leaves
-/// no `file`, or the old one. The temporary file is removed on failure. `write_chunk` (tests)
-/// replaces the write of each 64 KiB chunk. There is no fsync (it cost 8 ms a result here, more
-/// than the rest of a job's overhead): a machine that crashes may lose its latest results or
-/// leave one cut short, and the readers reject a result without its final line.
-void write_file_atomic(const std::filesystem::path& file, std::string_view text,
-                       const ChunkWriter& write_chunk = {});
+/// How a study writes a file others may read or write at once (a result, a report, a
+/// dataset's settings): through an AtomicFile whose temporary has a name unique over the
+/// machines sharing the directory (`.NAME.tmp-HOST-PID-N`, hidden), replacing the old file.
+/// With io's write_file_atomic(file, text, shared_file(file)): a process killed or failing
+/// part-way leaves no `file`, or the old one. There is no fsync (it cost 8 ms a result here,
+/// more than the rest of a job's overhead): a machine that crashes may lose its latest
+/// results or leave one cut short, and the readers reject a result without its final line.
+AtomicFileOptions shared_file(const std::filesystem::path& file);
 
 /// The whole file; nullopt-like empty string and false when it cannot be read.
 bool read_file(const std::filesystem::path& file, std::string& out);
@@ -51,21 +49,5 @@ std::string host_name();
 
 /// A unique suffix for temporary names: host, process id and a counter.
 std::string unique_suffix();
-
-/// An exclusive advisory lock (flock) on `file` (created if missing), held until
-/// destruction; waits for other holders. Where the file system has no locks (some network
-/// file systems) locked() is false and the caller relies on atomic renames alone.
-class FileLock {
- public:
-  explicit FileLock(const std::filesystem::path& file);
-  ~FileLock();
-  FileLock(const FileLock&) = delete;
-  FileLock& operator=(const FileLock&) = delete;
-  bool locked() const { return locked_; }
-
- private:
-  int fd_ = -1;
-  bool locked_ = false;
-};
 
 }  // namespace wheelins::study

@@ -21,6 +21,7 @@
 
 #include "wheelins/eval/run_evaluation.hpp"
 #include "wheelins/io/atomic_file.hpp"
+#include "wheelins/io/file_lock.hpp"
 #include "wheelins/io/truth.hpp"
 #include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/nav/types.hpp"
@@ -135,7 +136,7 @@ bool delete_dataset_when_done(const Study& s, const Job& j) {
     siblings.push_back(std::move(other));
   }
   const fs::path dir = s.cache_dir() / j.dataset.cache_name;
-  const FileLock lock(s.cache_dir() / (j.dataset.cache_name + ".lock"));
+  const FileLock lock(s.cache_dir() / (j.dataset.cache_name + ".lock"), FileLock::Wait::kUntilFree);
   for (const auto& o : siblings)  // again under the lock: a rerun may have started
     if (job_status(s, o).state != JobState::kDone) return false;
   std::error_code ec;
@@ -335,8 +336,9 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     const std::string result = result_json(s, j, data, req.modules, e, rr, warnings, tm, t, t0);
 
     t = std::chrono::steady_clock::now();
-    for (const auto& [file, text] : side) write_file_atomic(file, text);
-    write_file_atomic(result_file(s, j.index), result, o.write_chunk);
+    for (const auto& [file, text] : side) write_file_atomic(file, text, shared_file(file));
+    const fs::path path = result_file(s, j.index);
+    write_file_atomic(path, result, shared_file(path), o.write_chunk);
     tm.write = since(t);
   } catch (const Interrupted&) {
     throw;  // Ctrl-C or a kill: not a failure of the job (nothing of it is written)
@@ -344,7 +346,8 @@ JobOutcome run_job(const Study& s, const Job& j, const JobOptions& o) {
     out.error = e.what();
     // A result of these settings from before (a rerun) is not this run's: leave none behind.
     fs::remove(result_file(s, j.index), ec);
-    write_file_atomic(failure_file(s, j.index), failure_json(s, j, out.error, warnings, tm));
+    const fs::path path = failure_file(s, j.index);
+    write_file_atomic(path, failure_json(s, j, out.error, warnings, tm), shared_file(path));
     return out;
   }
   fs::remove(failure_file(s, j.index), ec);

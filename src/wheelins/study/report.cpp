@@ -507,7 +507,7 @@ void write_report_files(Report& rep, const fs::path& dir, const TextFiles& files
       for (const auto& n : plots.names) ours.check(fs::path("plots") / (n + ".png"), "\x89PNG\r");
   }
   for (const auto& [name, text] : files) {
-    write_file_atomic(dir / name, text);
+    write_file_atomic(dir / name, text, shared_file(dir / name));
     rep.files.push_back(dir / name);
     written.push_back(name);
   }
@@ -516,7 +516,7 @@ void write_report_files(Report& rep, const fs::path& dir, const TextFiles& files
     std::error_code ec;
     fs::create_directories(pdir / "data", ec);
     for (const auto& [rel, text] : plots.files) {
-      write_file_atomic(pdir / rel, text);
+      write_file_atomic(pdir / rel, text, shared_file(pdir / rel));
       rep.files.push_back(pdir / rel);
       written.push_back(fs::path("plots") / rel);
     }
