@@ -93,7 +93,7 @@ void print_run_summary(const RunRequest& req, const RunResult& res) {
   for (const auto& n : res.noise)
     for (const auto& w : n.warnings) warn(w);  // each names its module
   if (!res.weights.empty()) {
-    const auto s = summarize_weights(res.weights, static_cast<int>(req.modules.size()));
+    const std::vector<WeightSummary>& s = res.weight_summary;
     std::cout << "reference weights k_i (eq. 8), mean:";
     for (std::size_t i = 0; i < s.size(); ++i)
       std::printf("%s %s %.3f", i ? "," : "", req.modules[i].c_str(), s[i].mean);

@@ -180,6 +180,46 @@ class AliasBudget : public YAML::EventHandler {
 
 }  // namespace
 
+std::vector<std::string> dotted_key_parts(const std::string& key) {
+  std::vector<std::string> parts;
+  for (std::size_t from = 0;;) {
+    const std::size_t dot = key.find('.', from);
+    parts.push_back(key.substr(from, dot == std::string::npos ? std::string::npos : dot - from));
+    if (dot == std::string::npos) return parts;
+    from = dot + 1;
+  }
+}
+
+YAML::Node settings_document(const std::vector<std::string>& settings, const std::string& expected) {
+  YAML::Node root(YAML::NodeType::Map);
+  for (const std::string& s : settings) {
+    const std::string where = "--set '" + s + "'";
+    const std::size_t eq = s.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(where + ": expected KEY=VALUE, " + expected);
+    const YAML::Node value = parse_yaml(s.substr(eq + 1), where, "value");
+    if (!value.IsDefined() || value.IsNull()) throw InputError(where + ": no value after '='");
+    const std::string key = s.substr(0, eq);
+    const std::vector<std::string> parts = dotted_key_parts(key);
+    YAML::Node map = root;
+    std::string path;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const std::string& name = parts[k];
+      if (name.empty()) throw InputError(where + ": an empty part in the key '" + key + "'");
+      path += (path.empty() ? "" : ".") + name;
+      if (k + 1 == parts.size()) {
+        if (map[name].IsDefined() && !map[name].IsNull()) throw InputError(where + ": " + key + " is set twice");
+        map[name] = value;
+        break;
+      }
+      if (!map[name].IsDefined() || map[name].IsNull()) map[name] = YAML::Node(YAML::NodeType::Map);
+      if (!map[name].IsMap()) throw InputError(where + ": " + path + " is set as a value and as a section");
+      map.reset(map[name]);
+    }
+  }
+  return root;
+}
+
 YAML::Node parse_yaml(const std::string& text, const std::string& where, const std::string& kind) {
   if (text.size() > io_detail::kMaxYamlBytes)
     throw InputError(where + ": " + std::to_string(text.size()) + " bytes; a " + kind + " has at most " +

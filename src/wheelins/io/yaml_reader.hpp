@@ -25,6 +25,15 @@ namespace wheelins {
 /// `kind` says what the text is ("manifest", "study").
 YAML::Node parse_yaml(const std::string& text, const std::string& where, const std::string& kind);
 
+/// "filter.initial_std.heading_deg" -> {filter, initial_std, heading_deg} (empty parts kept).
+std::vector<std::string> dotted_key_parts(const std::string& key);
+
+/// `KEY=VALUE` settings (`--set filter.speed_window_s=0.1`: a dotted key, a YAML value read by
+/// parse_yaml) as one document: {filter: {speed_window_s: 0.1}, ...}. InputError naming the
+/// setting for one without '=' (saying `expected`, e.g. "a key of docs/run-config.md"), without
+/// a value, with an empty part in its key, set twice, or set as a value and as a section.
+YAML::Node settings_document(const std::vector<std::string>& settings, const std::string& expected);
+
 /// Reads and parses a YAML file with parse_yaml's checks, and first those of every input
 /// file (io_detail::check_input_file: a regular file). `kind` names the file in messages.
 YAML::Node load_yaml_file(const std::filesystem::path& file, const std::string& kind,

@@ -63,6 +63,7 @@ struct RunResult {
   std::string noise_report;                  ///< readable summary of it, with the warnings
   std::vector<WeightRecord> weights;         ///< the reference weights of eq. (8) over time (weights.csv)
   std::string weights_report;                ///< readable summary of them (multi-IMU runs)
+  std::vector<WeightSummary> weight_summary;  ///< per module: mean, least, greatest weight
   InstallationCalibration calibration;  ///< the installation estimates (calibration.yaml)
   std::string calibration_report;            ///< readable table of them (empty: not estimated)
   /// Against the truth (RunRequest::evaluation): the figures, the truth file, or why the

@@ -18,24 +18,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// "filter.initial_std.heading_deg" -> {filter, initial_std, heading_deg} (empty parts kept).
-std::vector<std::string> key_parts(const std::string& key) {
-  std::vector<std::string> parts;
-  for (std::size_t from = 0;;) {
-    const std::size_t dot = key.find('.', from);
-    parts.push_back(key.substr(from, dot == std::string::npos ? std::string::npos : dot - from));
-    if (dot == std::string::npos) return parts;
-    from = dot + 1;
-  }
-}
-
 /// The keys each map of the file may hold ("" for the top), from the declarations' dotted keys.
 struct KeyCollector {
   std::map<std::string, std::vector<std::string>> keys;
 
   void add(const std::string& key) {
     std::string parent;
-    for (const std::string& name : key_parts(key)) {
+    for (const std::string& name : dotted_key_parts(key)) {
       auto& list = keys[parent];
       if (std::find(list.begin(), list.end(), name) == list.end()) list.push_back(name);
       parent += (parent.empty() ? "" : ".") + name;
@@ -140,7 +129,7 @@ class YamlOptionReader {
 YAML::Node YamlOptionReader::node(const std::string& key) {
   std::vector<YAML::Node> way{y_.root()};
   std::string path;
-  for (const std::string& name : key_parts(key)) {
+  for (const std::string& name : dotted_key_parts(key)) {
     if (!way.back().IsDefined()) break;
     if (entered_.insert(path).second) {
       if (!path.empty()) y_.require_map(way.back(), path);
@@ -220,42 +209,16 @@ RunConfig read_run_config(const YamlReader& y, const fs::path& base) {
   return c;
 }
 
-/// `--set KEY=VALUE` settings as one YAML document: {filter: {speed_window_s: 0.1}, ...}.
-YAML::Node settings_document(const std::vector<std::string>& settings) {
-  YAML::Node root(YAML::NodeType::Map);
-  for (const std::string& s : settings) {
-    const std::string where = "--set '" + s + "'";
-    const std::size_t eq = s.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(where + ": expected KEY=VALUE, a key of docs/run-config.md (e.g. fusion.position_std_m=0.3)");
-    const YAML::Node value = parse_yaml(s.substr(eq + 1), where, "value");
-    if (!value.IsDefined() || value.IsNull()) throw InputError(where + ": no value after '='");
-    const std::string key = s.substr(0, eq);
-    const std::vector<std::string> parts = key_parts(key);
-    YAML::Node map = root;
-    std::string path;
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      const std::string& name = parts[k];
-      if (name.empty()) throw InputError(where + ": an empty part in the key '" + key + "'");
-      path += (path.empty() ? "" : ".") + name;
-      if (k + 1 == parts.size()) {
-        if (map[name].IsDefined() && !map[name].IsNull()) throw InputError(where + ": " + key + " is set twice");
-        map[name] = value;
-        break;
-      }
-      if (!map[name].IsDefined() || map[name].IsNull()) map[name] = YAML::Node(YAML::NodeType::Map);
-      if (!map[name].IsMap()) throw InputError(where + ": " + path + " is set as a value and as a section");
-      map.reset(map[name]);
-    }
-  }
-  return root;
-}
+}  // namespace
+
+namespace {
+constexpr const char* kSettingExample = "a key of docs/run-config.md (e.g. fusion.position_std_m=0.3)";
 }  // namespace
 
 void apply_run_settings(const std::vector<std::string>& settings, RunConfig& c) {
   if (settings.empty()) return;
   // An unknown key on the command line is a typo: an error, naming the closest known key.
-  const YamlReader y(settings_document(settings), "--set", warnings_are_errors(), false);
+  const YamlReader y(settings_document(settings, kSettingExample), "--set", warnings_are_errors(), false);
   read_run_config(y, fs::path(), c, false);
 }
 
@@ -306,13 +269,32 @@ void check_override_numbers(const RunOverrides& o) {
 
 }  // namespace
 
-RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
-  check_override_numbers(o);
-  RunConfig cfg = o.config.empty() ? RunConfig{} : load_run_config(o.config, warn);
-  apply_run_settings(o.settings, cfg);
-  if (!o.manifest.empty()) cfg.manifest = o.manifest;
-  if (cfg.manifest.empty())
-    throw InputError("no dataset: give a run configuration naming one, or a manifest (--manifest)");
+namespace {
+
+/// The front end's named choices as values, made before any file is read: a misspelt one
+/// stops the command before it reads anything.
+struct NamedChoices {
+  std::optional<SpeedSharing> speed;
+  std::optional<YawScaleFactorChoice> yaw_scale_factors;
+  std::optional<ReferenceWeighting> weights;
+  std::optional<CalibrationMode> calibration;
+  std::vector<TrajectoryFormat> formats;
+  std::optional<TumFrame> tum_frame;
+};
+
+NamedChoices named_choices(const RunOverrides& o) {
+  NamedChoices n;
+  if (!o.speed.empty()) n.speed = speed_sharing_from_name(o.speed);
+  if (!o.yaw_scale_factors.empty()) n.yaw_scale_factors = yaw_scale_factors_from_name(o.yaw_scale_factors);
+  if (!o.weights.empty()) n.weights = weighting_from_name(o.weights);
+  if (!o.calibration.empty()) n.calibration = calibration_mode_from_name(o.calibration);
+  for (const auto& f : o.formats) n.formats.push_back(trajectory_format_from_name(f));
+  if (!o.tum_frame.empty()) n.tum_frame = tum_frame_from_name(o.tum_frame);
+  return n;
+}
+
+/// Which IMUs: the front end's configuration, chips or modules over the file's.
+void apply_selection(const RunOverrides& o, RunConfig& cfg) {
   if (!o.modules.empty() && !o.configuration.empty())
     throw InputError("modules and configuration both given: the modules name the IMUs themselves; "
                      "give one of them");
@@ -325,19 +307,17 @@ RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
   }
   if (!o.chips.empty()) cfg.chips = o.chips;
   if (!o.modules.empty()) cfg.modules = o.modules;
-  if (!o.output_dir.empty()) cfg.output_dir = o.output_dir;
-  if (!o.formats.empty()) {
-    cfg.formats.clear();
-    for (const auto& f : o.formats) cfg.formats.push_back(trajectory_format_from_name(f));
-  }
-  if (!o.tum_frame.empty()) cfg.tum_frame = tum_frame_from_name(o.tum_frame);
-  if (!o.speed.empty()) cfg.nav.fusion.speed = speed_sharing_from_name(o.speed);
-  if (!o.yaw_scale_factors.empty()) cfg.nav.yaw_scale_factors = yaw_scale_factors_from_name(o.yaw_scale_factors);
-  if (!o.weights.empty()) {
-    cfg.nav.fusion.weighting = weighting_from_name(o.weights);
+}
+
+/// The named choices and switches over the file's.
+void apply_choices(const RunOverrides& o, const NamedChoices& n, RunConfig& cfg) {
+  if (n.speed) cfg.nav.fusion.speed = *n.speed;
+  if (n.yaw_scale_factors) cfg.nav.yaw_scale_factors = *n.yaw_scale_factors;
+  if (n.weights) {
+    cfg.nav.fusion.weighting = *n.weights;
     cfg.nav.fusion.weights.clear();  // over the configuration's list of fixed weights
   }
-  if (!o.calibration.empty()) cfg.calibration = calibration_mode_from_name(o.calibration);
+  if (n.calibration) cfg.calibration = *n.calibration;
   if (o.centralized) cfg.nav.fusion.centralized = *o.centralized;
   if (o.position_constraint) cfg.nav.fusion.position_constraint = *o.position_constraint;
   if (o.fault_handling) cfg.nav.faults.enabled = *o.fault_handling;
@@ -347,9 +327,39 @@ RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
   if (o.duration) cfg.max_duration = *o.duration;
   if (o.output_interval) cfg.nav.output_interval = *o.output_interval;
   if (o.covariance_interval) cfg.nav.covariance_interval = *o.covariance_interval;
+}
+
+/// Where and what is written, over the file's.
+void apply_output(const RunOverrides& o, const NamedChoices& n, RunConfig& cfg) {
+  if (!o.output_dir.empty()) cfg.output_dir = o.output_dir;
   if (o.overwrite) cfg.overwrite = true;
   if (o.full_rate) cfg.file_interval = 0.0;
   if (o.subsystems) cfg.write_subsystems = true;
+  if (!n.formats.empty()) cfg.formats = n.formats;
+  if (n.tum_frame) cfg.tum_frame = *n.tum_frame;
+}
+
+}  // namespace
+
+RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
+  // The front end's own values first (numbers in range, names known), then the files.
+  check_override_numbers(o);
+  const NamedChoices named = named_choices(o);
+  // The file and the --set settings over it, both parsed before either is read: the file's
+  // unknown keys are warnings, the settings' errors (a typo on the command line).
+  const YAML::Node settings = settings_document(o.settings, kSettingExample);
+  std::optional<YamlReader> file;
+  if (!o.config.empty()) file.emplace(o.config, warn, "run configuration");
+  const YamlReader set(settings, "--set", warnings_are_errors(), false);
+  RunConfig cfg;
+  if (file) read_run_config(*file, o.config.parent_path(), cfg, true);
+  if (!o.settings.empty()) read_run_config(set, fs::path(), cfg, false);
+  if (!o.manifest.empty()) cfg.manifest = o.manifest;
+  if (cfg.manifest.empty())
+    throw InputError("no dataset: give a run configuration naming one, or a manifest (--manifest)");
+  apply_selection(o, cfg);
+  apply_choices(o, named, cfg);
+  apply_output(o, named, cfg);
   return cfg;
 }
 

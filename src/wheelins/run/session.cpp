@@ -237,6 +237,7 @@ RunResult RunSession::finish(double process_seconds, const std::vector<SessionIn
   result.calibration = std::move(calibration_);
   result.weights = nav_->weight_history();
   result.weights_report = weights_report(result.weights, req_.modules, req_.nav.fusion);
+  result.weight_summary = summarize_weights(result.weights, static_cast<int>(req_.modules.size()));
   result.fault_report = fault_report_text(nav_->faults());
   if (!input_faults.empty()) {
     if (result.fault_report.rfind("faults: none detected", 0) == 0)
