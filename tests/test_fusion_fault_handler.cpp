@@ -322,3 +322,30 @@ TEST(FaultHandler, RestartAfterIsolationTakesTheSensorErrorsOfBeforeTheFault) {
   EXPECT_EQ(ekf.errors().bg, bad.bg);
   EXPECT_TRUE(act.forget_heading_offset[2]);  // its offset was tracked while the fault went undetected
 }
+
+TEST(OutputFusionOffsets, TheHeadingOffsetFollowsOverTheDeclaredWindow) {
+  // fusion.heading_offset_window_s: each module's offset to the mean heading moves toward its
+  // present value by the elapsed time over the window (e-folding); a tenth of the window moves
+  // it ten times as far as a hundredth would.
+  auto step = [](double window) {
+    Rig rig(2);
+    rig.opt.fusion.heading_offset_window = window;
+    OutputFusion out(*rig.subs, *rig.filter, rig.frame, rig.opt, [](int, const TrajectoryRecord&) {});
+    StaticAccumulator still;
+    for (int k = 0; k < 100; ++k) still.add(Rig::rest_sample(kT0 - 0.5 + k * kDt));
+    const OutputFusion::Use all{true, true};
+    (*rig.subs)[1].start(still, 0.1, kT0);  // right: 0.1 rad off the left
+    out.write(kT0, all, all);                // a first offset takes the present value
+    double before = 0.0;
+    EXPECT_TRUE(out.heading_offset(1, before));
+    (*rig.subs)[1].start(still, 0.3, kT0);   // now 0.3 rad off
+    out.write(kT0 + 1.0, all, all);
+    double after = 0.0;
+    EXPECT_TRUE(out.heading_offset(1, after));
+    EXPECT_NEAR(before, 0.05, 1e-9);  // half the difference from the mean of two
+    return after - before;
+  };
+  const double slow = step(100.0), fast = step(10.0);
+  EXPECT_NEAR(slow, 0.01 * 0.1, 1e-9);
+  EXPECT_NEAR(fast, 0.1 * 0.1, 1e-9);
+}

@@ -156,6 +156,8 @@ void NavigatorOptions::validate() const {
     fail("position constraint sigma: must be > 0 m", fusion.position_std);
   if (!(fusion.weight_window >= 1.0 && fusion.weight_window <= 1e6))
     fail("reference weight window: must be in [1, 1e6] constraint epochs", fusion.weight_window);
+  if (!(fusion.heading_offset_window > 0.0) || !std::isfinite(fusion.heading_offset_window))
+    fail("heading offset window: must be > 0 s", fusion.heading_offset_window);
   if (fusion.weighting != ReferenceWeighting::kFixed && !fusion.weights.empty())
     throw InputError("fusion weights: fixed weights and weights from the data exclude each other");
   noise.validate();

@@ -54,6 +54,9 @@ struct FusionOptions {
   ReferenceWeighting weighting = ReferenceWeighting::kFixed;
   /// kCovariance: constraint epochs the variances are averaged over (e-folding).
   double weight_window = 60.0;
+  /// [s] e-folding window of each subsystem's heading offset to the mean heading of all
+  /// (OutputFusion::heading_offset): what carries the fused heading through an outage.
+  double heading_offset_window = 30.0;
   /// One joint covariance over all IMUs (Section VI-B-2) instead of one per subsystem.
   bool centralized = false;
 };

@@ -26,6 +26,7 @@ OutputFusion::OutputFusion(const Subsystems& subs, const FilterBackend& filter,
       frame_(frame),
       share_level_(options.fusion.share_level),
       module_records_(options.module_records),
+      offset_window_(options.fusion.heading_offset_window),
       sink_(std::move(sink)) {
   last_record_t_.fill(-1e300);
 }
@@ -101,7 +102,7 @@ void OutputFusion::track_offsets(double t, const Use& vehicle, const Records& re
     c += subs_.weight(i) * std::cos(recs[i].rpy.z());
   }
   const double mean = std::atan2(s, c);
-  const double a = std::clamp((t - offset_t_) / kOffsetWindow, 0.0, 1.0);
+  const double a = std::clamp((t - offset_t_) / offset_window_, 0.0, 1.0);
   for (int i = 0; i < n; ++i) {
     // A new (or forgotten) offset starts from its present value.
     offset_[i] += (offset_valid_[i] ? a : 1.0) * wrap_pi(wrap_pi(recs[i].rpy.z() - mean) - offset_[i]);

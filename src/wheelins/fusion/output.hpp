@@ -31,11 +31,10 @@ class OutputFusion {
   /// outage.
   TrajectoryRecord fused(const Use& use) const;
   /// Subsystem i's heading less the weighted mean heading of all subsystems, averaged over
-  /// the last kOffsetWindow seconds in which all of them counted (frozen while not); false
+  /// the last FusionOptions::heading_offset_window seconds in which all of them counted (frozen while not); false
   /// before it has been seen. A module that comes back after an outage restarts from the
   /// others' heading plus its offset (fault_handler.cpp).
   bool heading_offset(int i, double& offset) const;
-  static constexpr double kOffsetWindow = 30.0;  ///< [s], e-folding
   /// Subsystem i's offset is not known (it was isolated: a fault may have moved its heading
   /// before it was detected) until all subsystems count again.
   void forget_heading_offset(int i) { offset_valid_[i] = false; }
@@ -57,6 +56,7 @@ class OutputFusion {
   const FilterBackend& filter_;
   const earth::LocalFrame& frame_;
   bool share_level_, module_records_;
+  double offset_window_;  ///< [s], e-folding
   Sink sink_;
   Records recs_{};                              ///< scratch of write() (no allocation per epoch)
   std::array<double, kMaxModules> last_record_t_;  ///< time of each subsystem's last record

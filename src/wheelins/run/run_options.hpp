@@ -240,6 +240,11 @@ void declare_fusion_options(V& v, RunConfig& c) {
   v.number({"fusion.weight_window_epochs", "covariance weights: constraint epochs the variances average over",
             ""},
            f.weight_window, {1.0, 1e6, "constraint epochs"});
+  v.number({"fusion.heading_offset_window_s",
+            "each IMU's heading offset to the mean heading of all is averaged over this window (e-folding); "
+            "it carries the fused heading through an outage (docs/faults.md)",
+            ""},
+           f.heading_offset_window, {1.0, 3600.0, "s"});
   v.flag({"fusion.centralized", "one joint covariance (paper Section VI-B-2); not on a single module",
           "--centralized"},
          f.centralized);
