@@ -209,10 +209,8 @@ RunConfig read_run_config(const YamlReader& y, const fs::path& base) {
   return c;
 }
 
-}  // namespace
-
-namespace {
 constexpr const char* kSettingExample = "a key of docs/run-config.md (e.g. fusion.position_std_m=0.3)";
+
 }  // namespace
 
 void apply_run_settings(const std::vector<std::string>& settings, RunConfig& c) {
@@ -266,10 +264,6 @@ void check_override_numbers(const RunOverrides& o) {
     check_range(*value, option, r.lo, r.hi, r.unit);
   }
 }
-
-}  // namespace
-
-namespace {
 
 /// The front end's named choices as values, made before any file is read: a misspelt one
 /// stops the command before it reads anything.

@@ -506,14 +506,7 @@ void SimConfig::apply_setting(const std::string& assignment) {
   const std::string path = assignment.substr(0, eq);
   const YAML::Node value = parse_yaml(assignment.substr(eq + 1), "--set '" + assignment + "'", "setting");
   // Build {a: {b: {c: value}}}.
-  std::vector<std::string> parts;
-  std::size_t pos = 0;
-  while (true) {
-    const auto dot = path.find('.', pos);
-    parts.push_back(path.substr(pos, dot == std::string::npos ? std::string::npos : dot - pos));
-    if (dot == std::string::npos) break;
-    pos = dot + 1;
-  }
+  const std::vector<std::string> parts = dotted_key_parts(path);
   YAML::Node node = value;
   for (auto it = parts.rbegin(); it != parts.rend(); ++it) {
     YAML::Node m(YAML::NodeType::Map);
