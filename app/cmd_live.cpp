@@ -32,11 +32,10 @@ namespace {
 using namespace wheelins;
 
 struct LiveArgs {
-  std::string config_file, manifest, configuration, chips, modules, out, formats, calibration, format = "json";
+  std::string config_file, format = "json";
   double warmup = 120.0, window = 0.05, publish_interval = 0.1, idle_exit = 0.0;
   std::optional<int> udp_port;  // none: standard input
-  std::optional<double> duration;
-  bool centralized = false, no_faults = false, fixed_noise = false, force = false, full_rate = false;
+  std::vector<NamedSetting> named;    ///< the run settings' options (run/run_options.hpp), as given
   std::vector<std::string> settings;  ///< --set KEY=VALUE
 };
 
@@ -164,24 +163,9 @@ double cpu_seconds() {
 }
 
 RunRequest live_request(const LiveArgs& a, const WarningSink& warn) {
-  RunOverrides o;
-  o.config = a.config_file;
-  o.manifest = a.manifest;
-  o.configuration = a.configuration;
-  if (!a.chips.empty()) o.chips = cli::split_list(a.chips);
-  if (!a.modules.empty()) o.modules = cli::split_list(a.modules);
-  o.output_dir = a.out;
-  if (!a.formats.empty()) o.formats = cli::split_list(a.formats);
-  o.calibration = a.calibration.empty() ? "estimate" : a.calibration;
-  if (a.centralized) o.centralized = true;
-  if (a.no_faults) o.fault_handling = false;
-  if (a.fixed_noise) o.fixed_noise = true;
-  o.duration = a.duration;
-  o.overwrite = a.force;
-  o.full_rate = a.full_rate;
-  o.settings = a.settings;
-  RunRequest req = make_run_request(run_config_with(o, warn), warn);
-  if (a.out.empty()) req.output_dir.clear();  // the states go out; files only when asked for
+  const RunConfig cfg = run_config_with(RunOverrides{a.config_file, a.named, a.settings}, warn);
+  RunRequest req = make_run_request(cfg, warn);
+  if (cfg.output_dir.empty()) req.output_dir.clear();  // the states go out; files only when asked for
   return req;
 }
 
@@ -266,36 +250,24 @@ const bool registered = cli::register_command(
     [](CLI::App& sub) {
       auto a = std::make_shared<LiveArgs>();
       sub.add_option("config", a->config_file, "Run configuration (YAML; see docs/run-config.md)");
-      sub.add_option("--manifest,-m", a->manifest, "Dataset manifest: the modules, their geometry and formats");
-      sub.add_option("--configuration,-c", a->configuration, "IMU configuration, as `wheelins run` (default: single)");
-      sub.add_option("--chips", a->chips, "Chip per IMU, e.g. C1,C4");
-      sub.add_option("--modules", a->modules, "Explicit module names (instead of a configuration)");
-      sub.add_option("--out,-o", a->out, "Also write the run's files here at the end (as `wheelins run`)");
-      sub.add_option("--formats", a->formats, "Trajectory formats of those files: csv,tum,kml");
+      cli::add_run_setting_options(sub, a->named);  // as `wheelins run` (docs/run-config.md)
       sub.add_option("--format", a->format, "The published states: json (JSON lines; default) or csv");
       sub.add_option("--publish-interval", a->publish_interval,
                      "Seconds of data between published states (default 0.1; 0: after every sample)");
       sub.add_option("--window", a->window,
                      "Reorder window [s]: records up to this much older than the newest are put back in "
                      "order; older ones are dropped (default 0.05)");
-      sub.add_option("--calibration", a->calibration,
-                     "estimate (default: the installation from the first seconds after the static period) "
-                     "| manifest (as given)");
       sub.add_option("--calibration-warmup", a->warmup,
                      "Seconds of data the installation is estimated from (default 120); no state is "
                      "published before its end");
-      sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
       sub.add_option("--udp", a->udp_port,
                      "Read the lines from UDP datagrams on 127.0.0.1:PORT instead of standard input (each "
                      "datagram whole lines)");
       sub.add_option("--idle-exit", a->idle_exit,
                      "End the run when no input arrived for this many seconds (default 0: never)");
-      sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
-      sub.add_flag("--no-fault-handling", a->no_faults, "Use every sample and module as it comes");
-      sub.add_flag("--fixed-noise", a->fixed_noise, "Hold the noise figures fixed");
-      sub.add_flag("--full-rate", a->full_rate, "The trajectory files at every record");
-      sub.add_flag("--force,-f", a->force, "Overwrite existing results in --out");
       cli::add_settings_option(sub, a->settings);
+      sub.footer("Files (the trajectory, calibration.yaml, ...) are written at the end only when --out or the "
+                 "configuration's output.dir names a directory.");
       return [a]() { return live(*a); };
     });
 }  // namespace

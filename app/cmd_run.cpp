@@ -22,31 +22,13 @@ using namespace wheelins;
 
 struct RunArgs {
   std::string config_file;
-  std::string manifest;
-  std::string configuration;
-  std::string chips;
-  std::string modules;
-  std::string out;
-  std::string formats, tum_frame;
-  std::string speed;
-  std::string weights;
-  std::string yaw;
-  std::string calibration;
-  bool centralized = false;
-  bool no_constraint = false;
-  bool no_faults = false;
-  bool no_standstill = false;
-  bool fixed_noise = false;
+  std::vector<NamedSetting> named;    ///< the run settings' options (run/run_options.hpp), as given
+  std::vector<std::string> settings;  ///< --set KEY=VALUE, any key of docs/run-config.md
   bool no_evaluate = false;
-  bool no_data_checks = false;
-  bool force = false;
   bool quiet = false;
   bool verbose = false;
-  bool full_rate = false;
-  bool subsystems = false;
-  std::optional<double> duration, output_interval, covariance_interval, align_start;
+  std::optional<double> align_start;
   std::string antenna;
-  std::vector<std::string> settings;  ///< --set KEY=VALUE, any key of docs/run-config.md
 };
 
 /// The statistics of the run every summary starts with: time, updates, covariance checks.
@@ -115,46 +97,9 @@ void print_run_summary(const RunRequest& req, const RunResult& res) {
   std::cout << ")\n";
 }
 
-/// The command line's settings over the run configuration (run/run_config.hpp: RunOverrides,
-/// applied as Python's run() applies its keywords).
-RunOverrides overrides_of(const RunArgs& a) {
-  RunOverrides o;
-  o.config = a.config_file;
-  o.manifest = a.manifest;
-  o.configuration = a.configuration;
-  if (!a.chips.empty()) o.chips = cli::split_list(a.chips);
-  if (!a.modules.empty()) {
-    o.modules = cli::split_list(a.modules);
-    if (o.modules.empty()) throw InputError("--modules '" + a.modules + "': no module named");
-  }
-  o.output_dir = a.out;
-  if (!a.formats.empty()) o.formats = cli::split_list(a.formats);
-  o.tum_frame = a.tum_frame;
-  o.speed = a.speed;
-  o.weights = a.weights;
-  o.yaw_scale_factors = a.yaw;
-  o.calibration = a.calibration;
-  auto flag = [](bool set, bool value) { return set ? std::optional<bool>(value) : std::nullopt; };
-  o.centralized = flag(a.centralized, true);
-  o.position_constraint = flag(a.no_constraint, false);
-  o.fault_handling = flag(a.no_faults, false);
-  o.standstill = flag(a.no_standstill, false);
-  o.fixed_noise = flag(a.fixed_noise, true);
-  o.data_checks = flag(a.no_data_checks, false);
-  o.duration = a.duration;
-  o.output_interval = a.output_interval;
-  o.covariance_interval = a.covariance_interval;
-  o.overwrite = a.force;
-  o.full_rate = a.full_rate;
-  o.subsystems = a.subsystems;
-  o.settings = a.settings;
-  return o;
-}
-
 int run(const RunArgs& a) {
-  const RunOverrides overrides = overrides_of(a);
   const WarningSink warn = stderr_sink();  // one sink: each warning once
-  const RunConfig cfg = run_config_with(overrides, warn);
+  const RunConfig cfg = run_config_with(RunOverrides{a.config_file, a.named, a.settings}, warn);
   RunRequest req = make_run_request(cfg, warn);
   req.progress = !a.quiet;
 
@@ -166,7 +111,7 @@ int run(const RunArgs& a) {
   std::cout << "wheelins run: " << cfg.configuration << " [";
   for (std::size_t i = 0; i < req.modules.size(); ++i) std::cout << (i ? ", " : "") << req.modules[i];
   std::cout << "] on '" << req.manifest.path.string() << "'\n";
-  if (a.verbose) std::cout << req.nav.describe();
+  if (a.verbose) std::cout << run_options_listing(cfg);
   if (!req.manifest.heading_known)
     std::cout << "initial heading:            not in the manifest: a local frame (odometry frame, as ROS's odom) "
                  "with the vehicle's heading 0 at the start\n";
@@ -188,66 +133,20 @@ const bool registered = cli::register_command(
     [](CLI::App& sub) {
       auto a = std::make_shared<RunArgs>();
       sub.add_option("config", a->config_file, "Run configuration (YAML; see docs/run-config.md)");
-      sub.add_option("--manifest,-m", a->manifest, "Dataset manifest (overrides the config's)");
-      std::string configurations;  // from the presets, so the help cannot fall behind them
-      for (const auto& n : configuration_names())
-        configurations += (configurations.empty() ? "" : " | ") + n + (n == "single" ? " | single-right" : "");
-      sub.add_option("--configuration,-c", a->configuration, configurations + " (default: single)");
-      sub.add_option("--chips", a->chips, "Chip per IMU, e.g. C1,C4 (default: the first of each)");
-      sub.add_option("--modules", a->modules, "Explicit module names (instead of a configuration)");
-      sub.add_option("--out,-o", a->out, "Output directory");
-      sub.add_option("--formats", a->formats, "Trajectory formats: csv,tum,kml (default: all)");
-      sub.add_option("--tum-frame", a->tum_frame,
-                     "trajectory.tum's frame: ned (x north, y east, z down; the default) or enu (x east, "
-                     "y north, z up; body x forward, y left, z up: ROS, evo)");
-      sub.add_option("--speed", a->speed, "Wheel speed sharing: own (default) | mean (paper)");
-      sub.add_option("--yaw-scale-factors", a->yaw,
-                     "Yaw-rate scale factors: auto (default: from the position constraint with a "
-                     "Body-IMU, else held) | held | constraint | estimated");
-      sub.add_option("--weights", a->weights,
-                     "Reference weights k_i of eq. (8): equal (paper) | covariance (each "
-                     "subsystem's own uncertainty) | standalone (each subsystem's drift without the "
-                     "constraint; weights.csv)");
-      sub.add_option("--calibration", a->calibration,
-                     "installation geometry: estimate (default: from the data, "
-                     "calibration.yaml) | manifest (as given)");
-      sub.add_flag("--centralized", a->centralized, "One joint covariance over all IMUs");
-      sub.add_flag("--no-position-constraint", a->no_constraint, "Disable the multi-IMU constraint");
+      cli::add_run_setting_options(sub, a->named);  // --manifest, --configuration, ... (docs/run-config.md)
       sub.add_flag("--no-evaluate", a->no_evaluate,
                    "Do not evaluate against the manifest's truth (the evaluation streams the truth "
                    "file alongside the run)");
-      sub.add_flag("--no-data-checks", a->no_data_checks,
-                   "Run the manifest as it is, without holding it against its data first (the axle "
-                   "axis and sign, clock offsets, kinds, sides, a body's mounting)");
-      sub.add_flag("--fixed-noise", a->fixed_noise,
-                   "Hold the manifest's noise figures (or the defaults) fixed instead of identifying "
-                   "them from the data (docs/filter.md section 13)");
-      sub.add_flag("--no-fault-handling", a->no_faults,
-                   "Use every sample and module as it comes (no outage, saturation, slip or "
-                   "fault isolation)");
-      sub.add_flag("--no-standstill", a->no_standstill,
-                   "No zero-velocity detection: a standing vehicle gets the wheel-speed updates of a "
-                   "moving one (docs/faults.md, \"Standing still\")");
-      sub.add_option("--duration", a->duration, "Stop after this many seconds of navigation");
       sub.add_option("--antenna", a->antenna,
                      "Evaluation: the truth's antenna X,Y,Z in the vehicle frame [m] (default: the manifest's "
                      "vehicle.antenna_v_m)");
       sub.add_option("--align-start", a->align_start,
                      "Evaluation: align the trajectory's first METRES of travel onto the truth's (default: 100 "
                      "when the manifest has no initial heading, else 0 = off)");
-      sub.add_option("--output-interval", a->output_interval, "Output interval [s]; 0 = every epoch");
-      sub.add_option("--covariance-interval", a->covariance_interval,
-                     "Covariance time update every this many seconds (F integrated in between); "
-                     "0 = every IMU epoch; at most 0.5 s");
       cli::add_settings_option(sub, a->settings);
-      sub.add_flag("--force,-f", a->force, "Overwrite existing results");
       sub.add_flag("--quiet,-q", a->quiet, "No progress line");
       sub.add_flag("--verbose,-v", a->verbose,
                    "Also the option listing, the calibration, noise and weight tables, and every file written");
-      sub.add_flag("--full-rate", a->full_rate,
-                   "Write the trajectory at every record (default: every 0.1 s, output.file_interval_s)");
-      sub.add_flag("--subsystems", a->subsystems,
-                   "Also write each IMU's own trajectory, <module>.csv (multi-IMU runs)");
       return [a]() { return run(*a); };
     });
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "cli.hpp"
 #include "wheelins/nav/types.hpp"
+#include "wheelins/run/run_options.hpp"
 #include "wheelins/util/interrupt.hpp"
 
 namespace wheelins::cli {
@@ -33,6 +34,16 @@ void add_settings_option(CLI::App& sub, std::vector<std::string>& settings) {
                  "KEY=VALUE: any setting of the run configuration (docs/run-config.md, e.g. "
                  "fusion.position_std_m=0.3; VALUE is YAML), over the file; repeat it for more")
       ->allow_extra_args(false);
+}
+
+void add_run_setting_options(CLI::App& sub, std::vector<NamedSetting>& named) {
+  for (const NamedOption& o : run_named_options()) {
+    if (o.sets.empty())
+      sub.add_option_function<std::string>(
+          o.names, [&named, &o](const std::string& v) { named.push_back(cli_setting(o.option, v)); }, o.help);
+    else
+      sub.add_flag_callback(o.names, [&named, &o] { named.push_back(cli_setting(o.option)); }, o.help);
+  }
 }
 
 std::vector<std::string> split_list(const std::string& text) {

@@ -31,6 +31,7 @@
 #include "wheelins/run/push_session.hpp"
 #include "wheelins/run/run.hpp"
 #include "wheelins/run/run_config.hpp"
+#include "wheelins/run/run_options.hpp"
 #include "wheelins/run/noise_report.hpp"
 #include "wheelins/sim/simulator.hpp"
 #include "wheelins/util/interrupt.hpp"
@@ -139,14 +140,16 @@ py::dict faults_dict(const std::vector<FaultEvent>& events, const std::vector<st
   return out;
 }
 
-/// The command line's words in a message, as a Python caller spells them.
+/// The command line's words in a message, as a Python caller spells them: the options without
+/// a value as their keywords (--force as force=True, --no-data-checks as data_checks=False).
 std::string python_message(std::string m) {
-  const std::pair<const char*, const char*> words[] = {
-      {"use --force to", "use force=True to"}, {"--force", "force=True"}, {"--set '", "setting '"},
-      {"--set ", "setting "}, {"--centralized", "centralized=True"}, {"--no-data-checks", "data_checks: false"}};
+  std::vector<std::pair<std::string, std::string>> words = {
+      {"use --force to", "use force=True to"}, {"--set '", "setting '"}, {"--set ", "setting "}};
+  for (const NamedOption& o : run_named_options())
+    if (!o.sets.empty()) words.emplace_back(o.option, o.keyword + (o.keyword_value(true) == o.sets ? "=True" : "=False"));
   for (const auto& [cli, py] : words)
-    for (std::size_t at = m.find(cli); at != std::string::npos; at = m.find(cli, at + std::strlen(py)))
-      m.replace(at, std::strlen(cli), py);
+    for (std::size_t at = m.find(cli); at != std::string::npos; at = m.find(cli, at + py.size()))
+      m.replace(at, cli.size(), py);
   return m;
 }
 
@@ -190,31 +193,47 @@ std::optional<std::string> text(const py::object& o) {
   return py::str(py::module_::import("os").attr("fspath")(o)).cast<std::string>();
 }
 
-/// The settings run() and Navigator() share, as `wheelins run` takes them (its options by name).
-RunOverrides shared_settings(const py::object& manifest, const std::string& configuration,
-                             const std::vector<std::string>& chips, const std::vector<std::string>& modules,
-                             const py::object& config, const std::string& speed, std::optional<bool> centralized,
-                             std::optional<bool> position_constraint, std::optional<bool> fault_handling,
-                             std::optional<double> duration, std::optional<double> output_interval,
-                             std::optional<double> covariance_interval, const std::string& yaw_scale_factors,
-                             const std::string& calibration, const std::vector<std::string>& settings) {
-  RunOverrides s;
-  s.config = text(config).value_or("");
-  s.manifest = text(manifest).value_or("");
-  s.configuration = configuration;
-  s.chips = chips;
-  s.modules = modules;
-  s.speed = speed;
-  s.yaw_scale_factors = yaw_scale_factors;
-  s.calibration = calibration;
-  s.centralized = centralized;
-  s.position_constraint = position_constraint;
-  s.fault_handling = fault_handling;
-  s.duration = duration;
-  s.output_interval = output_interval;
-  s.covariance_interval = covariance_interval;
-  s.settings = settings;  // KEY=VALUE each, as `--set`
-  return s;
+/// A keyword's value as an option's text: True/False as YAML's, numbers exactly, paths.
+std::string keyword_text(const std::string& keyword, const py::handle& v) {
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(v)) return py::str(v).cast<std::string>();
+  if (py::isinstance<py::float_>(v)) return py::repr(py::float_(py::reinterpret_borrow<py::object>(v))).cast<std::string>();
+  if (py::isinstance<py::str>(v) || py::hasattr(v, "__fspath__")) return *text(py::reinterpret_borrow<py::object>(v));
+  throw InputError(keyword + ": expected a number, a text, True or False, got " + py::repr(v).cast<std::string>());
+}
+
+/// run()'s and Navigator()'s keywords as `wheelins run`'s options (their names from the run
+/// settings' declarations, run/run_options.hpp: run_named_options); None: not given.
+std::vector<NamedSetting> keyword_settings(const py::dict& keywords) {
+  std::vector<NamedSetting> out;
+  for (const auto& [k, v] : keywords) {
+    const std::string keyword = py::str(k).cast<std::string>();
+    const NamedOption* o = find_named_option(keyword);
+    if (!o || o->keyword != keyword) throw py::type_error("unexpected keyword argument '" + keyword + "'");
+    if (v.is_none()) continue;
+    NamedSetting s{keyword, o->key, {}, false};
+    if (!o->sets.empty()) {
+      if (!py::isinstance<py::bool_>(v))
+        throw InputError(keyword + ": expected True or False, got " + py::repr(v).cast<std::string>());
+      const std::optional<std::string> value = o->keyword_value(v.cast<bool>());
+      if (!value) continue;
+      s.values = {*value};
+    } else if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
+      s.list = true;
+      for (const py::handle item : v) s.values.push_back(keyword_text(keyword, item));
+    } else {
+      s.values = {keyword_text(keyword, v)};
+    }
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+/// The keywords run() and Navigator() take for the run settings, each with its setting's key.
+std::vector<std::pair<std::string, std::string>> run_keywords() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const NamedOption& o : run_named_options()) out.emplace_back(o.keyword, o.key);
+  return out;
 }
 
 // ----------------------------------------------------------------------------- run
@@ -235,24 +254,9 @@ struct RunOutput {
   double wall_seconds = 0.0;
 };
 
-RunOutput run(const py::object& manifest, const std::string& configuration, const std::vector<std::string>& chips,
-              const std::vector<std::string>& modules, const py::object& config, const py::object& out,
-              const std::vector<std::string>& formats, const std::string& speed, std::optional<bool> centralized,
-              std::optional<bool> position_constraint, std::optional<bool> fault_handling, bool evaluate,
-              std::optional<double> duration, std::optional<double> output_interval,
-              std::optional<double> covariance_interval, const std::string& weights,
-              std::optional<bool> fixed_noise, const std::string& yaw_scale_factors,
-              const std::string& calibration, bool force, bool progress, bool full_rate,
-              bool subsystems, const std::vector<std::string>& settings) {
-  RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
-                                   position_constraint, fault_handling, duration, output_interval,
-                                   covariance_interval, yaw_scale_factors, calibration, settings);
-  s.formats = formats;
-  s.weights = weights;
-  s.fixed_noise = fixed_noise;
-  s.overwrite = force;
-  s.full_rate = full_rate;
-  s.subsystems = subsystems;
+RunOutput run(const py::object& config, const py::object& out, bool evaluate, bool progress, const py::dict& keywords,
+              const std::vector<std::string>& settings) {
+  const RunOverrides s{text(config).value_or(""), keyword_settings(keywords), settings};
   const WarningSink warn = stderr_sink();
   const std::optional<std::string> out_dir = text(out);
   RunRequest req = make_run_request(run_config_with(s, warn), warn);
@@ -379,13 +383,8 @@ py::dict simulate(const py::object& out, const std::vector<std::string>& setting
 /// passed through the run's input checks, then the RunSession every run goes through.
 class StreamNavigator {
  public:
-  StreamNavigator(const py::object& manifest, const std::string& configuration, const std::vector<std::string>& chips,
-                  const std::vector<std::string>& modules, const py::object& config, const std::string& speed,
-                  std::optional<bool> centralized, std::optional<bool> position_constraint,
-                  std::optional<bool> fault_handling, std::optional<double> duration,
-                  std::optional<double> output_interval, std::optional<double> covariance_interval,
-                  const std::string& yaw_scale_factors, const std::string& calibration,
-                  double calibration_warmup, const std::vector<std::string>& settings);
+  StreamNavigator(const py::object& config, const py::dict& keywords, double calibration_warmup,
+                  const std::vector<std::string>& settings);
 
   int index_of(const py::object& module) const;
 
@@ -439,22 +438,17 @@ class StreamNavigator {
   std::unique_ptr<PushSession> run_;
 };
 
-StreamNavigator::StreamNavigator(const py::object& manifest, const std::string& configuration,
-                                 const std::vector<std::string>& chips, const std::vector<std::string>& modules,
-                                 const py::object& config, const std::string& speed, std::optional<bool> centralized,
-                                 std::optional<bool> position_constraint, std::optional<bool> fault_handling,
-                                 std::optional<double> duration, std::optional<double> output_interval,
-                                 std::optional<double> covariance_interval, const std::string& yaw_scale_factors,
-                                 const std::string& calibration, double calibration_warmup,
+StreamNavigator::StreamNavigator(const py::object& config, const py::dict& keywords, double calibration_warmup,
                                  const std::vector<std::string>& settings) {
   // It sees each sample once. "manifest" (the default): the manifest's geometry as it is
   // (a calibrated manifest comes from `wheelins calibrate`). "estimate": the installation
   // geometry estimated from the first `calibration_warmup` seconds after the static period,
   // whose samples are kept and navigated when it ends (docs/python.md).
-  const RunOverrides s = shared_settings(manifest, configuration, chips, modules, config, speed, centralized,
-                                         position_constraint, fault_handling, duration, output_interval,
-                                         covariance_interval, yaw_scale_factors,
-                                         calibration.empty() ? "manifest" : calibration, settings);
+  py::dict named;
+  named["calibration"] = "manifest";
+  for (const auto& [k, v] : keywords)
+    if (!v.is_none()) named[k] = v;
+  const RunOverrides s{text(config).value_or(""), keyword_settings(named), settings};
   const WarningSink warn = stderr_sink();
   RunRequest req = make_run_request(run_config_with(s, warn), warn);
   req.output_dir.clear();
@@ -559,15 +553,11 @@ void bind_run_output(py::module_& m) {
 
 /// run, evaluate, read_truth and simulate (after RunOutput, which run() returns).
 void bind_functions(py::module_& m) {
-  m.def("run", &run, py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
-        py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("out") = py::none(),
-        py::arg("formats") = std::vector<std::string>{}, py::arg("speed") = "", py::arg("centralized") = py::none(),
-        py::arg("position_constraint") = py::none(), py::arg("fault_handling") = py::none(), py::arg("evaluate") = true,
-        py::arg("duration") = py::none(), py::arg("output_interval") = py::none(),
-        py::arg("covariance_interval") = py::none(), py::arg("weights") = "", py::arg("fixed_noise") = py::none(),
-        py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("force") = false,
-        py::arg("progress") = false, py::arg("full_rate") = false, py::arg("subsystems") = false,
+  m.def("run", &run, py::kw_only(), py::arg("config") = py::none(), py::arg("out") = py::none(),
+        py::arg("evaluate") = true, py::arg("progress") = false, py::arg("keywords") = py::dict(),
         py::arg("settings") = std::vector<std::string>{});
+  m.def("run_keywords", &run_keywords,
+        "The run settings' keywords of run() and Navigator(), each with its setting's key (docs/run-config.md)");
   m.def("evaluate", &evaluate, py::arg("truth"), py::arg("trajectory"), py::kw_only(), py::arg("format") = "auto",
         py::arg("truth_layout") = "auto", py::arg("segment") = 100.0, py::arg("max_gap") = 5.0, py::arg("align") = false,
         py::arg("origin") = py::none(), py::arg("series") = false);
@@ -578,16 +568,8 @@ void bind_functions(py::module_& m) {
 
 void bind_navigator(py::module_& m) {
   py::class_<StreamNavigator>(m, "Navigator")
-      .def(py::init<const py::object&, const std::string&, const std::vector<std::string>&, const std::vector<std::string>&,
-                    const py::object&, const std::string&, std::optional<bool>, std::optional<bool>, std::optional<bool>,
-                    std::optional<double>, std::optional<double>, std::optional<double>, const std::string&,
-                    const std::string&, double, const std::vector<std::string>&>(),
-           py::arg("manifest"), py::kw_only(), py::arg("configuration") = "", py::arg("chips") = std::vector<std::string>{},
-           py::arg("modules") = std::vector<std::string>{}, py::arg("config") = py::none(), py::arg("speed") = "",
-           py::arg("centralized") = py::none(), py::arg("position_constraint") = py::none(),
-           py::arg("fault_handling") = py::none(), py::arg("duration") = py::none(),
-           py::arg("output_interval") = py::none(), py::arg("covariance_interval") = py::none(),
-           py::arg("yaw_scale_factors") = "", py::arg("calibration") = "", py::arg("calibration_warmup") = 120.0,
+      .def(py::init<const py::object&, const py::dict&, double, const std::vector<std::string>&>(), py::kw_only(),
+           py::arg("config") = py::none(), py::arg("keywords") = py::dict(), py::arg("calibration_warmup") = 120.0,
            py::arg("settings") = std::vector<std::string>{})
       .def("push", &StreamNavigator::push, py::arg("module"), py::arg("t"), py::arg("gyro"), py::arg("accel"))
       .def("finish", &StreamNavigator::finish)

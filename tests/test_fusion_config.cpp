@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <optional>
 
 #include "dataset_test_util.hpp"
 #include "io_test_util.hpp"
@@ -16,6 +18,18 @@ using iotest::ScratchDir;
 using iotest::write_text;
 
 namespace {
+
+/// What a run configuration holds, as text to compare two: every setting's value.
+std::string config_text(const RunConfig& c) { return run_options_listing(c); }
+
+RunConfig config_with(std::vector<NamedSetting> named, std::vector<std::string> settings = {}) {
+  RunOverrides o;
+  o.named = std::move(named);
+  o.named.insert(o.named.begin(), cli_setting("-m", "m.yaml"));
+  o.settings = std::move(settings);
+  return run_config_with(o, {});
+}
+
 Manifest three_groups() {
   Manifest m;
   m.path = "/data/m.yaml";
@@ -154,8 +168,10 @@ TEST(FusionRunConfig, YawScaleFactorsAndTheOlderKey) {
     load("dataset: m.yaml\nfilter:\n  yaw_scale_factors: held\n  estimate_yaw_scale_factors: true\n");
   });
   EXPECT_NE(e.find("filter.estimate_yaw_scale_factors: conflicts with filter.yaw_scale_factors"), std::string::npos) << e;
-  EXPECT_EQ(yaw_scale_factors_from_name("estimated"), YawScaleFactorChoice::kEstimated);
-  EXPECT_NE(error_of([] { yaw_scale_factors_from_name("x"); }).find("expected auto, held, constraint or estimated"),
+  EXPECT_EQ(config_with({cli_setting("--yaw-scale-factors", "estimated")}).nav.yaw_scale_factors,
+            YawScaleFactorChoice::kEstimated);
+  EXPECT_NE(error_of([] { config_with({cli_setting("--yaw-scale-factors", "x")}); })
+                .find("--yaw-scale-factors: filter.yaw_scale_factors: expected auto or held or constraint or estimated"),
             std::string::npos);
 }
 
@@ -282,9 +298,14 @@ TEST(RunOptions, TheDeclaredCommandLineOptionsExist) {
   for (std::size_t row = table.find("\n| `"); row != std::string::npos; row = table.find("\n| `", row + 1)) {
     const std::size_t cell = table.find(" | ", row + 3) + 3;
     if (table.compare(cell, 1, "`") != 0) continue;
-    const std::string flag = table.substr(cell + 1, table.find('`', cell + 1) - cell - 1);
-    const bool listed = help.out.find(flag + " ") != std::string::npos || help.out.find(flag + ",") != std::string::npos;
-    EXPECT_TRUE(listed) << flag << " is not an option of wheelins run";
+    const std::string flags = table.substr(cell + 1, table.find('`', cell + 1) - cell - 1);
+    for (std::size_t at = 0; at <= flags.size();) {  // each name of "--out,-o"
+      const std::size_t end = std::min(flags.find(',', at), flags.size());
+      const std::string flag = flags.substr(at, end - at);
+      const bool listed = help.out.find(flag + " ") != std::string::npos || help.out.find(flag + ",") != std::string::npos;
+      EXPECT_TRUE(listed) << flag << " is not an option of wheelins run";
+      at = end + 1;
+    }
     ++named;
   }
   EXPECT_GT(named, 15);
@@ -329,3 +350,114 @@ TEST(RunOptions, SetGivesAnyDeclaredKeyOverTheFile) {
   e = error({"fusion.speed=fast"});
   EXPECT_NE(e.find("--set: fusion.speed: expected mean or own"), std::string::npos) << e;
 }
+
+namespace {
+
+// Issue 35: the front ends' named options come from the declarations. Each sets its key as
+// `--set KEY=VALUE` does (the switches what their text says), by any of its names.
+TEST(RunOptions, EachNamedOptionSetsItsDeclaredKey) {
+  const std::string defaults = config_text(config_with({}));
+  int switches = 0;
+  for (const NamedOption& o : run_named_options()) {
+    if (o.sets.empty()) continue;
+    const std::string named = config_text(config_with({cli_setting(o.option)}));
+    EXPECT_EQ(named, config_text(config_with({}, {o.key + "=" + o.sets}))) << o.option;
+    EXPECT_NE(named, defaults) << o.option << " changes nothing";
+    ++switches;
+  }
+  EXPECT_GE(switches, 8);
+  const std::vector<std::array<const char*, 3>> values = {
+      {"--duration", "60", "duration_s=60"},
+      {"--chips", "C1,C4", "chips=[C1, C4]"},
+      {"--configuration", "triple", "configuration=triple"},
+      {"-c", "dual-wheel", "configuration=dual-wheel"},
+      {"--modules", "left-C1", "modules=[left-C1]"},
+      {"--out", "somewhere", "output.dir=somewhere"},
+      {"-o", "a,b", "output.dir='a,b'"},
+      {"--formats", "csv,kml", "output.formats=[csv, kml]"},
+      {"--tum-frame", "enu", "output.tum_frame=enu"},
+      {"--output-interval", "0.5", "output.interval_s=0.5"},
+      {"--covariance-interval", "0.1", "filter.covariance_interval_s=0.1"},
+      {"--speed", "mean", "fusion.speed=mean"},
+      {"--yaw-scale-factors", "estimated", "filter.yaw_scale_factors=estimated"},
+      {"--weights", "covariance", "fusion.weights=covariance"},
+      {"--weights", "1,2,1", "fusion.weights=[1, 2, 1]"},
+      {"--calibration", "manifest", "calibration=manifest"}};
+  for (const auto& [option, value, set] : values) {
+    const std::string named = config_text(config_with({cli_setting(option, value)}));
+    EXPECT_EQ(named, config_text(config_with({}, {set}))) << option << " " << value;
+    EXPECT_NE(named, defaults) << option << " " << value << " changes nothing";
+  }
+  EXPECT_EQ(config_with({cli_setting("--out", "x")}).output_dir, "x");  // relative to the working directory
+  EXPECT_NE(error_of([] { (void)cli_setting("--antenna", "1,2,3"); }).find("not an option of a run setting"),
+            std::string::npos);
+}
+
+// Named options over --set over the file; the file's modules and fixed weights give way to a
+// named configuration and named weights.
+TEST(RunOptions, NamedOptionsGoOverSettingsAndTheFile) {
+  ScratchDir dir;
+  write_text(dir / "run.yaml", "dataset: m.yaml\nmodules: [left-C1]\nfusion: {weights: [1, 2]}\nduration_s: 10\n");
+  RunOverrides o;
+  o.config = dir / "run.yaml";
+  o.settings = {"duration_s=20"};
+  o.named = {cli_setting("--duration", "30"), cli_setting("-c", "triple"), cli_setting("--weights", "covariance")};
+  const RunConfig c = run_config_with(o, {});
+  EXPECT_DOUBLE_EQ(c.max_duration, 30.0);
+  EXPECT_EQ(c.configuration, "triple");
+  EXPECT_TRUE(c.modules.empty());
+  EXPECT_TRUE(c.nav.fusion.weights.empty());
+  EXPECT_EQ(c.nav.fusion.weighting, ReferenceWeighting::kCovariance);
+  o.named = {cli_setting("--duration", "30")};
+  EXPECT_EQ(run_config_with(o, {}).modules, std::vector<std::string>{"left-C1"});
+}
+
+// A mistake in a named option names the option (and the key), and stops the command before a
+// file is read; modules exclude a configuration and chips.
+TEST(RunOptions, ANamedOptionsMistakeNamesIt) {
+  auto error = [](std::vector<NamedSetting> named) {
+    RunOverrides o;
+    o.config = "/nonexistent/run.yaml";  // never read: the options are checked first
+    o.named = std::move(named);
+    return error_of([&] { run_config_with(o, {}); });
+  };
+  EXPECT_NE(error({cli_setting("--duration", "0")}).find("--duration: duration_s: must be > 0 s"), std::string::npos)
+      << error({cli_setting("--duration", "0")});
+  EXPECT_NE(error({cli_setting("--duration", "1e400")}).find("--duration: duration_s:"), std::string::npos);
+  EXPECT_NE(error({cli_setting("--duration", "abc")}).find("--duration: duration_s:"), std::string::npos);
+  EXPECT_NE(error({cli_setting("--output-interval", "9")}).find("--output-interval: output.interval_s: must be in [0, 5]"),
+            std::string::npos);
+  EXPECT_NE(error({cli_setting("--speed", "fast")}).find("--speed: fusion.speed:"), std::string::npos);
+  EXPECT_NE(error({cli_setting("--chips", "C1,,C4")}).find("--chips: chips[1]"), std::string::npos);
+  EXPECT_NE(error({cli_setting("--tum-frame", "xyz")}).find("--tum-frame: output.tum_frame: 'xyz'"), std::string::npos);
+  EXPECT_NE(error({cli_setting("--modules", "left-C1"), cli_setting("-c", "triple")})
+                .find("modules and configuration both given"),
+            std::string::npos);
+  EXPECT_NE(error({cli_setting("--modules", "left-C1"), cli_setting("--chips", "C1")}).find("modules and chips"),
+            std::string::npos);
+  EXPECT_NE(error({}).find("/nonexistent/run.yaml"), std::string::npos);  // the file is read when the options are good
+}
+
+// Python's keywords are the options' names: a switch's keyword takes True or False.
+TEST(RunOptions, PythonsKeywordsAreTheOptionsNames) {
+  auto keyword = [](const char* name) {
+    const NamedOption* o = find_named_option(name);
+    EXPECT_NE(o, nullptr) << name;
+    return o;
+  };
+  EXPECT_EQ(keyword("position_constraint")->option, "--no-position-constraint");
+  EXPECT_EQ(keyword("position_constraint")->keyword_value(false), "false");
+  EXPECT_EQ(keyword("position_constraint")->keyword_value(true), "true");
+  EXPECT_EQ(keyword("fixed_noise")->keyword_value(true), "false");  // noise.adapt
+  EXPECT_EQ(keyword("fixed_noise")->keyword_value(false), "true");
+  EXPECT_EQ(keyword("full_rate")->keyword_value(true), "0");
+  EXPECT_EQ(keyword("full_rate")->keyword_value(false), std::nullopt);
+  EXPECT_EQ(keyword("centralized")->keyword_value(false), "false");
+  EXPECT_EQ(keyword("output_interval")->key, "output.interval_s");
+  EXPECT_EQ(keyword("out")->key, "output.dir");
+  EXPECT_EQ(keyword("--out"), keyword("out"));
+  EXPECT_EQ(find_named_option("no_such_option"), nullptr);
+  EXPECT_THROW((void)keyword("duration")->keyword_value(true), std::logic_error);
+}
+
+}  // namespace

@@ -60,7 +60,7 @@ TEST_F(RunOutput, ASummaryByDefaultTheTablesWithVerbose) {
   const CmdResult r = run("short", "");
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_LE(lines(r.out).size(), 20u) << r.out;
-  EXPECT_EQ(r.out.find("velocity update interval:"), std::string::npos) << r.out;  // the option listing
+  EXPECT_EQ(r.out.find("filter.velocity_update_hz"), std::string::npos) << r.out;  // the option listing
   EXPECT_NE(line_of(r.out, "wrote 7 files to ").find("--full-rate"), std::string::npos) << r.out;
   EXPECT_NE(line_of(r.out, "reference weights k_i (eq. 8), mean: left-C1 0.333"), "") << r.out;
   EXPECT_NE(line_of(r.out, "drift rate"), "") << r.out;
@@ -73,7 +73,7 @@ TEST_F(RunOutput, ASummaryByDefaultTheTablesWithVerbose) {
 
   const CmdResult v = run("verbose", "-v");
   ASSERT_EQ(v.code, 0) << v.err;
-  EXPECT_NE(v.out.find("velocity update interval:"), std::string::npos) << v.out;
+  EXPECT_NE(v.out.find("  filter.velocity_update_hz"), std::string::npos) << v.out;
   EXPECT_NE(v.out.find("installation calibration (estimate"), std::string::npos) << v.out;
   EXPECT_NE(v.out.find("wrote " + (dir_->path() / "verbose" / "trajectory.csv").string()), std::string::npos);
   EXPECT_GT(lines(v.out).size(), lines(r.out).size() + 15);
@@ -149,11 +149,9 @@ TEST_F(RunOutput, OverridesApplyOverTheConfigurationFile) {
   EXPECT_DOUBLE_EQ(c.file_interval, 0.5);
   EXPECT_EQ(c.nav.fusion.weights.size(), 2u);
 
-  o.configuration = "triple";  // over the file's configuration and its module list
-  o.weights = "covariance";    // over the file's fixed weights
-  o.full_rate = true;
-  o.subsystems = true;
-  o.fixed_noise = true;
+  o.named = {cli_setting("-c", "triple"),  // over the file's configuration and its module list
+             cli_setting("--weights", "covariance"),  // over the file's fixed weights
+             cli_setting("--full-rate"), cli_setting("--subsystems"), cli_setting("--fixed-noise")};
   c = run_config_with(o, {});
   EXPECT_EQ(c.configuration, "triple");
   EXPECT_TRUE(c.modules.empty());
@@ -163,7 +161,7 @@ TEST_F(RunOutput, OverridesApplyOverTheConfigurationFile) {
   EXPECT_TRUE(c.write_subsystems);
   EXPECT_FALSE(c.nav.noise.enabled);
 
-  o.modules = {"left-C1"};  // both ways of choosing the IMUs: an error
+  o.named.push_back(cli_setting("--modules", "left-C1"));  // both ways of choosing the IMUs: an error
   EXPECT_THROW(run_config_with(o, {}), InputError);
   RunOverrides none;
   EXPECT_THROW(run_config_with(none, {}), InputError);  // no dataset

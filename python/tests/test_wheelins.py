@@ -135,6 +135,26 @@ def test_run_weights_and_fixed_noise_as_the_cli(dataset, tmp_path):
         wheelins.run(dataset["manifest"], "triple", weights="inverse", duration=5.0)
 
 
+def test_keywords_are_the_options_of_wheelins_run(dataset, tmp_path):
+    """Every option of `wheelins run` that sets a run setting is a keyword, named from its
+    declaration (issue 35): standstill=False is --no-standstill, data_checks=False
+    --no-data-checks, tum_frame="enu" --tum-frame enu; a wrong value names the keyword."""
+    r = wheelins.run(dataset["manifest"], "dual-wheel", out=tmp_path / "py", duration=15.0, standstill=False,
+                     data_checks=False, tum_frame="enu", fault_handling=False, full_rate=True)
+    cli("run", "-m", dataset["manifest"], "-c", "dual-wheel", "-o", tmp_path / "cli", "--duration", 15,
+        "--no-standstill", "--no-data-checks", "--tum-frame", "enu", "--no-fault-handling", "--full-rate", "-q")
+    same_as_csv(r.trajectory, read_csv(tmp_path / "cli" / "trajectory.csv"))
+    assert (tmp_path / "py" / "trajectory.tum").read_text() == (tmp_path / "cli" / "trajectory.tum").read_text()
+    nav = wheelins.Navigator(dataset["manifest"], configuration="dual-wheel", standstill=False, weights="covariance")
+    assert nav.modules == r.modules
+    with pytest.raises(wheelins.InputError, match=r"^duration: duration_s: must be > 0 s"):
+        wheelins.run(dataset["manifest"], duration=0.0)
+    with pytest.raises(wheelins.InputError, match="standstill: expected True or False"):
+        wheelins.run(dataset["manifest"], standstill="no")
+    with pytest.raises(TypeError, match="'full_rate'"):
+        wheelins.Navigator(dataset["manifest"], full_rate=True)  # an output's keyword: not the Navigator's
+
+
 def test_settings_set_any_key_as_the_clis_set(dataset, tmp_path):
     settings = {"fusion.position_std_m": 0.5, "fusion.weights": [1, 2, 1], "standstill.enabled": False}
     r = wheelins.run(dataset["manifest"], "triple", out=tmp_path / "py", formats=["csv"], duration=20.0,
@@ -302,7 +322,8 @@ def test_errors_are_the_cli_messages(dataset, tmp_path):
     p = cli("run", "-m", dataset["manifest"], "-c", "quadruple", "-q", check=False)
     with pytest.raises(wheelins.InputError) as e:
         wheelins.run(dataset["manifest"], configuration="quadruple")
-    assert p.stderr.strip().endswith(f"error: {e.value}")
+    assert str(e.value) == "configuration: unknown configuration 'quadruple'"  # the keyword, as Python spells it
+    assert p.stderr.strip().endswith(f"error: --{e.value}")
 
     nav = wheelins.Navigator(dataset["manifest"], configuration="body-wheel")
     with pytest.raises(wheelins.InputError, match="module 'right-C1' is not navigated"):

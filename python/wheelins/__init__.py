@@ -43,12 +43,14 @@ __all__ = ["InputError", "Navigator", "Result", "csv_columns", "evaluate", "read
 
 
 # The keyword arguments of run() and Navigator() beyond their named ones: the options of
-# `wheelins run` by name.
-_RUN_SETTINGS = ("speed", "centralized", "position_constraint", "fault_handling", "duration", "output_interval",
-                 "covariance_interval", "weights", "fixed_noise", "yaw_scale_factors", "calibration", "settings")
-_NAVIGATOR_SETTINGS = ("speed", "centralized", "position_constraint", "fault_handling", "duration",
-                       "output_interval", "covariance_interval", "yaw_scale_factors", "calibration",
-                       "calibration_warmup", "settings")
+# `wheelins run` by name, from the run settings' declarations (--no-position-constraint is
+# position_constraint=False, --fixed-noise fixed_noise=True, --output-interval output_interval).
+_RUN_KEYWORDS = dict(_core.run_keywords())  # keyword -> the setting's key (docs/run-config.md)
+_NAMED = ("manifest", "configuration", "chips", "modules")
+_RUN_SETTINGS = tuple(k for k in _RUN_KEYWORDS if k not in _NAMED + ("out", "formats", "force", "full_rate",
+                                                                      "subsystems")) + ("settings",)
+_NAVIGATOR_SETTINGS = tuple(k for k, key in _RUN_KEYWORDS.items()
+                            if k not in _NAMED and not key.startswith("output.")) + ("calibration_warmup", "settings")
 _EVALUATE_OPTIONS = ("format", "truth_layout", "segment", "max_gap", "align", "origin")
 
 
@@ -162,7 +164,7 @@ class Result:
 
 
 def run(manifest, configuration=None, chips=None, *, modules=None, config=None, out=None, formats=None,
-        evaluate=True, progress=False, force=False, full_rate=False, subsystems=False, **filter_settings):
+        evaluate=True, progress=False, force=None, full_rate=None, subsystems=None, **filter_settings):
     """Navigates a dataset as `wheelins run` does and returns a Result.
 
     configuration: single | dual-wheel | body-wheel | triple; chips: e.g. ["C1", "C4"]
@@ -175,17 +177,22 @@ def run(manifest, configuration=None, chips=None, *, modules=None, config=None, 
     fault_handling=False, duration=60.0, output_interval=0.1, covariance_interval=0.0,
     weights="covariance" (or "equal"), fixed_noise=True, yaw_scale_factors="held" (or "auto",
     "constraint", "estimated"), calibration="manifest" (or "estimate", the default: the
-    Wheel-IMUs' mounting and lever arm estimated from the data first). settings: any key
+    Wheel-IMUs' mounting and lever arm estimated from the data first), standstill=False,
+    data_checks=False, tum_frame="enu"; every option of `wheelins run` that sets a run
+    setting, named as its long option without "--" (and "no-"), "-" as "_". settings: any key
     of the run configuration (docs/run-config.md) as `--set` takes it, e.g.
     settings={"fusion.position_std_m": 0.3, "fusion.weights": [1, 2, 1]}.
     """
     _check_keywords("run", filter_settings, _RUN_SETTINGS)
     if isinstance(chips, str):
         chips = [c for c in chips.split(",") if c]
-    return Result(_core.run(manifest, configuration=configuration or "", chips=list(chips or []),
-                            modules=list(modules or []), config=config, out=out, formats=list(formats or []),
-                            evaluate=evaluate, progress=progress, force=force, full_rate=full_rate,
-                            subsystems=subsystems, **_run_settings(filter_settings)))
+    keywords = {"manifest": manifest, "configuration": configuration or None, "chips": list(chips or []) or None,
+                "modules": list(modules or []) or None, "formats": list(formats or []) or None, "force": force,
+                "full_rate": full_rate, "subsystems": subsystems}
+    settings = _run_settings(filter_settings)
+    flat = settings.pop("settings", [])
+    return Result(_core.run(config=config, out=out, evaluate=evaluate, progress=progress,
+                            keywords={**keywords, **settings}, settings=flat))
 
 
 _SERIES = ["t_s", "distance_m", "err_n_m", "err_e_m", "err_d_m", "err_h_m", "heading_err_deg", "sigma_h_m", "nees_h"]
@@ -258,9 +265,12 @@ class Navigator:
             with open(manifest, "w") as f:
                 _json.dump(spec, f)
         try:
-            self._nav = _core.Navigator(manifest, configuration=configuration or "", chips=list(chips or []),
-                                        modules=list(modules or []), config=config,
-                                        **_run_settings(filter_settings))
+            settings = _run_settings(filter_settings)
+            warmup = settings.pop("calibration_warmup", 120.0)
+            flat = settings.pop("settings", [])
+            keywords = {"manifest": manifest, "configuration": configuration or None,
+                        "chips": list(chips or []) or None, "modules": list(modules or []) or None, **settings}
+            self._nav = _core.Navigator(config=config, keywords=keywords, calibration_warmup=warmup, settings=flat)
         finally:
             if tmp:
                 _shutil.rmtree(tmp, ignore_errors=True)

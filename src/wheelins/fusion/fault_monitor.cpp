@@ -41,24 +41,6 @@ void FaultOptions::validate() const {
                      "), got " + std::to_string(max_failed));
 }
 
-std::string FaultOptions::describe() const {
-  std::ostringstream o;
-  o << "longest outage bridged:     " << max_outage << " s without data from any module (longer: an error)\n";
-  if (!enabled) return o.str() + "fault handling:             off\n";
-  o << "fault handling:             on: out after " << stale_after << " s without data, gap > "
-    << max_gap << " s, realign " << realign_time << " s, probation " << probation << " s\n"
-    << "fault detector:             " << max_failed << " of " << window
-    << " velocity tests over test ratio " << test_ratio << "; retry after " << retry_after
-    << " s; heading " << heading_gate * 180.0 / 3.14159265358979323846 << " deg off the others for "
-    << heading_epochs << " epochs (3+ modules)\n"
-    << "wheel speed check:          " << speed_gate << " sigma from its INS and "
-    << wheel_mismatch << " m/s (or 10 %) from the other wheels; saturation at "
-    << saturation_margin * 100 << " % of full scale, held " << saturation_hold << " s\n"
-    << "wheel direction check:      a wheel rolling against the others (and the body) above "
-    << reverse_speed << " m/s for " << reverse_time << " s is isolated for the run\n";
-  return o.str();
-}
-
 const char* to_string(Health h) {
   switch (h) {
     case Health::kOk: return "ok";

@@ -49,8 +49,6 @@ struct FaultOptions {
 
   /// Throws InputError naming the option if a value is out of range.
   void validate() const;
-  /// One line per option, in human units.
-  std::string describe() const;
 };
 
 /// No data from any module for longer than FaultOptions::max_outage: the navigation cannot go

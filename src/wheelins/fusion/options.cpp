@@ -1,4 +1,5 @@
-// NavigatorOptions::describe() (the option listing of `wheelins run`) and validate().
+// NavigatorOptions::resolved() and the options' validate() (for options built in code; a run
+// configuration's settings are checked as they are read, run/run_options.hpp).
 #include "wheelins/fusion/options.hpp"
 
 #include <cmath>
@@ -7,20 +8,6 @@
 #include <utility>
 
 namespace wheelins {
-
-namespace {
-const char* describe_yaw(YawScaleFactorChoice c) {
-  switch (c) {
-    case YawScaleFactorChoice::kAuto:
-      return "from the position constraint when it takes in a Body-IMU, else held "
-             "(unobservable without a heading reference)";
-    case YawScaleFactorChoice::kHeld: return "held (unobservable without a heading reference)";
-    case YawScaleFactorChoice::kFromConstraint: return "from the position constraint only";
-    case YawScaleFactorChoice::kEstimated: return "estimated from every update";
-  }
-  return "?";
-}
-}  // namespace
 
 NavigatorOptions NavigatorOptions::resolved(int n_modules, bool has_body) const {
   NavigatorOptions o = *this;
@@ -43,71 +30,6 @@ NavigatorOptions NavigatorOptions::resolved(int n_modules, bool has_body) const 
   }
   o.wheel.yaw_scale_factors = o.body.yaw_scale_factors = mode;
   return o;
-}
-
-std::string NavigatorOptions::describe() const {
-  std::ostringstream o;
-  auto onoff = [](bool b) { return b ? "on" : "off"; };
-  o << "velocity update interval:   " << wheel.velocity_update_interval << " s\n"
-    << "wheel speed window:         " << wheel.speed_window << " s\n"
-    << "Wheel-INS velocity model:   "
-    << (wheel.turn_average ? "averaged over the last whole wheel turn (within " +
-                                 std::to_string(wheel.turn_window) + " s)"
-                           : std::string("at the update epoch (paper)")) << "\n"
-    << "wheel speed sharing:        "
-    << (fusion.speed == SpeedSharing::kMean ? "mean of Wheel-IMUs (paper)" : "own wheel (Body-INS: their mean)") << "\n"
-    << "Wheel-INS velocity sigma:   " << wheel.velocity_std.transpose() << " m/s\n"
-    << "Body-INS velocity sigma:    " << body.velocity_std.transpose() << " m/s\n"
-    << "position constraint:        " << onoff(fusion.position_constraint) << ", every "
-    << fusion.position_update_interval << " s, sigma " << fusion.position_std << " m\n"
-    << "reference weights (eq. 8):  "
-    << (fusion.weighting == ReferenceWeighting::kCovariance
-            ? "inverse variance of each subsystem's o, averaged over " +
-                  std::to_string(static_cast<int>(fusion.weight_window)) + " constraint epochs"
-            : fusion.weighting == ReferenceWeighting::kStandalone
-                ? std::string("inverse of each subsystem's drift on its own (federated, no reset)")
-                : std::string(fusion.weights.empty() ? "equal (paper)" : "fixed, as configured"))
-    << "\n"
-    << "Body-INS level to wheels:   " << onoff(fusion.share_level) << "\n"
-    << "filter structure:           "
-    << (fusion.centralized ? "centralized (one joint covariance)"
-                          : "distributed (paper; with several IMUs its 1-sigma figures are too small, "
-                            "--centralized gives consistent ones)") << "\n"
-    << "innovation gates (vel/pos): " << wheel.gate << " / " << fusion.position_gate
-    << " (0 = off)\n"
-    << "initial sigma:              position " << wheel.init.position << " m, velocity "
-    << wheel.init.velocity << " m/s, roll/pitch " << wheel.init.roll_pitch / kDeg
-    << " deg, heading " << wheel.init.heading / kDeg << " deg\n"
-    << "mechanization:              "
-    << (mechanization == MechanizationOptions::Method::kRotationExact ? "rotation-exact"
-                                                                       : "classic two-sample")
-    << "\n"
-    << "earth rotation:             " << (earth_rotation ? "compensated" : "ignored") << "\n"
-    << "covariance time update:     "
-    << (covariance_interval > 0 ? "every " + std::to_string(covariance_interval) + " s"
-                                : std::string("every epoch"))
-    << "\n"
-    << "noise model:                "
-    << (noise.enabled ? "identified from the data (rest: Allan variance; motion: Mehra, window " +
-                            std::to_string(static_cast<int>(noise.window)) + " updates)"
-                      : std::string("the given figures, held fixed"))
-    << "\n"
-    << "yaw-rate scale factors:     " << describe_yaw(yaw_scale_factors) << "\n"
-    << "axle accelerometer SF:      "
-    << (wheel.estimate_axle_accel_scale_factor ? "estimated" : "held (not told from its bias on one-way turns)")
-    << "\n"
-    << faults.describe()
-    << "standstill:                 "
-    << (standstill.enabled
-            ? "zero velocity and rate while every IMU is quiet for " + std::to_string(standstill.min_time) +
-                  " s (rates < " + std::to_string(standstill.max_rate / kDeg) + " deg/s, specific force within " +
-                  std::to_string(standstill.max_force_spread) + " m/s^2)"
-            : std::string("off"))
-    << "\n"
-    << "output interval:            "
-    << (output_interval > 0 ? std::to_string(output_interval) + " s" : std::string("every epoch"))
-    << "\n";
-  return o.str();
 }
 
 void NoiseAdaptationOptions::validate() const {

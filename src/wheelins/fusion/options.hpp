@@ -113,8 +113,6 @@ struct NavigatorOptions {
   /// These options for a navigator over `n_modules` modules, `has_body` when one is a
   /// Body-IMU: wheel/body.yaw_scale_factors set from `yaw_scale_factors` (kAuto decided here).
   NavigatorOptions resolved(int n_modules, bool has_body) const;
-  /// The options in human units (OpenVINS style), one per line.
-  std::string describe() const;
   /// Throws InputError naming the option if a value is out of range (the fault options
   /// are checked by FaultOptions::validate()).
   void validate() const;

@@ -7,7 +7,6 @@
 #include <map>
 #include <optional>
 #include <set>
-#include <tuple>
 
 #include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/run/presets.hpp"
@@ -41,7 +40,7 @@ struct KeyCollector {
   template <class E>
   void choice(const OptionInfo& i, E&, const OptionChoices<E>&) { add(i.key); }
   template <class F>
-  void custom(const OptionInfo& i, const char*, const char*, F&&) { add(i.key); }
+  void custom(const OptionInfo& i, const char*, OptionShow, F&&) { add(i.key); }
   template <class F>
   void section_check(const char*, F&&) {}
 };
@@ -94,7 +93,7 @@ class YamlOptionReader {
     if (const YAML::Node v = node(i.key); v.IsDefined()) e = y_.choice<E>(v, i.key, names);
   }
   template <class F>
-  void custom(const OptionInfo& i, const char*, const char*, F&& read) {
+  void custom(const OptionInfo& i, const char*, OptionShow, F&& read) {
     if (const YAML::Node v = node(i.key); v.IsDefined()) read(y_, v, *config_, base_);
   }
   template <class F>
@@ -179,10 +178,6 @@ SpeedSharing speed_sharing_from_name(const std::string& name) {
   return choice_from_name("wheel speed sharing", name, speed_sharing_choices());
 }
 
-YawScaleFactorChoice yaw_scale_factors_from_name(const std::string& name) {
-  return choice_from_name("yaw scale factors", name, yaw_scale_factor_choices());
-}
-
 CalibrationMode calibration_mode_from_name(const std::string& name) {
   return choice_from_name("calibration", name, calibration_mode_choices());
 }
@@ -239,106 +234,80 @@ RunConfig load_run_config(const YAML::Node& settings, const fs::path& base, cons
   return read_run_config(y, base);
 }
 
+NamedSetting cli_setting(const std::string& option, const std::string& value) {
+  const NamedOption* o = nullptr;
+  for (const NamedOption& n : run_named_options())
+    if (("," + n.names + ",").find("," + option + ",") != std::string::npos) o = &n;
+  if (!o) throw InputError(option + ": not an option of a run setting");
+  NamedSetting s{o->option, o->key, {}, false};
+  if (!o->sets.empty()) {
+    s.values = {o->sets};
+  } else if (o->path || value.find(',') == std::string::npos) {
+    s.values = {value};
+  } else {
+    s.list = true;
+    for (std::size_t start = 0;;) {  // "a,b,,c": each item, empty ones too (the reading names them)
+      const std::size_t k = value.find(',', start);
+      s.values.push_back(value.substr(start, k == std::string::npos ? std::string::npos : k - start));
+      if (k == std::string::npos) break;
+      start = k + 1;
+    }
+  }
+  return s;
+}
+
 namespace {
 
-/// A front end's number (its command-line option `option`) in its range [lo, hi] (NaN,
-/// infinities and 1e400 fail too); `lo_open`: lo itself excluded.
-void check_range(const std::optional<double>& v, const char* option, double lo, double hi, const char* unit,
-                 bool lo_open = false) {
-  if (!v) return;
-  const double x = *v;
-  if (!std::isfinite(x) || x < lo || x > hi || (lo_open && x == lo)) {
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "%s %g: must be in %s%g, %g] %s", option, x, lo_open ? "(" : "[", lo, hi, unit);
-    throw InputError(buf);
+/// The named options read over `c`, one by one so that a message names the option.
+void apply_named(const std::vector<NamedSetting>& named, RunConfig& c) {
+  for (const NamedSetting& s : named) {
+    YAML::Node doc(YAML::NodeType::Map);
+    YAML::Node at = doc;
+    const std::vector<std::string> parts = dotted_key_parts(s.key);
+    for (std::size_t k = 0; k + 1 < parts.size(); ++k) {
+      at[parts[k]] = YAML::Node(YAML::NodeType::Map);
+      at.reset(at[parts[k]]);
+    }
+    YAML::Node value;
+    if (s.list)
+      for (const std::string& v : s.values) value.push_back(v);
+    else
+      value = s.values.empty() ? std::string() : s.values.front();
+    at[parts.back()] = value;
+    try {
+      const YamlReader y(doc, s.name, warnings_are_errors(), false);
+      read_run_config(y, fs::path(), c, false);
+    } catch (const InputError& e) {
+      // "--configuration: configuration: ..." says the name once.
+      const std::string m = e.what(), twice = s.name + ": " + s.key + ": ";
+      const bool same = s.name == s.key || s.name == "--" + s.key;
+      if (!same || m.rfind(twice, 0) != 0) throw;
+      throw InputError(s.name + ": " + m.substr(twice.size()));
+    }
   }
 }
 
-/// The numbers a front end gives over the file, in the ranges the file's keys have.
-void check_override_numbers(const RunOverrides& o) {
-  check_range(o.duration, "--duration", 0.0, 1e7, "s", true);
-  for (const auto& [value, option, key] :
-       {std::tuple{&o.output_interval, "--output-interval", "output.interval_s"},
-        std::tuple{&o.covariance_interval, "--covariance-interval", "filter.covariance_interval_s"}}) {
-    const OptionRange r = run_option_range(key);
-    check_range(*value, option, r.lo, r.hi, r.unit);
-  }
-}
-
-/// The front end's named choices as values, made before any file is read: a misspelt one
-/// stops the command before it reads anything.
-struct NamedChoices {
-  std::optional<SpeedSharing> speed;
-  std::optional<YawScaleFactorChoice> yaw_scale_factors;
-  std::optional<ReferenceWeighting> weights;
-  std::optional<CalibrationMode> calibration;
-  std::vector<TrajectoryFormat> formats;
-  std::optional<TumFrame> tum_frame;
-};
-
-NamedChoices named_choices(const RunOverrides& o) {
-  NamedChoices n;
-  if (!o.speed.empty()) n.speed = speed_sharing_from_name(o.speed);
-  if (!o.yaw_scale_factors.empty()) n.yaw_scale_factors = yaw_scale_factors_from_name(o.yaw_scale_factors);
-  if (!o.weights.empty()) n.weights = weighting_from_name(o.weights);
-  if (!o.calibration.empty()) n.calibration = calibration_mode_from_name(o.calibration);
-  for (const auto& f : o.formats) n.formats.push_back(trajectory_format_from_name(f));
-  if (!o.tum_frame.empty()) n.tum_frame = tum_frame_from_name(o.tum_frame);
-  return n;
-}
-
-/// Which IMUs: the front end's configuration, chips or modules over the file's.
-void apply_selection(const RunOverrides& o, RunConfig& cfg) {
-  if (!o.modules.empty() && !o.configuration.empty())
+/// Which IMUs: modules name them, a configuration and chips choose them; not both ways.
+void check_selection(const std::vector<NamedSetting>& named) {
+  auto given = [&](const char* key) {
+    return std::any_of(named.begin(), named.end(), [&](const NamedSetting& s) { return s.key == key; });
+  };
+  if (given("modules") && given("configuration"))
     throw InputError("modules and configuration both given: the modules name the IMUs themselves; "
                      "give one of them");
-  if (!o.modules.empty() && !o.chips.empty())
+  if (given("modules") && given("chips"))
     throw InputError("modules and chips both given: chips pick the chips of a configuration; with "
                      "modules name the chips' modules (e.g. left-C2)");
-  if (!o.configuration.empty()) {
-    cfg.configuration = o.configuration;
-    cfg.modules.clear();  // the front end's choice over the configuration file's modules
-  }
-  if (!o.chips.empty()) cfg.chips = o.chips;
-  if (!o.modules.empty()) cfg.modules = o.modules;
-}
-
-/// The named choices and switches over the file's.
-void apply_choices(const RunOverrides& o, const NamedChoices& n, RunConfig& cfg) {
-  if (n.speed) cfg.nav.fusion.speed = *n.speed;
-  if (n.yaw_scale_factors) cfg.nav.yaw_scale_factors = *n.yaw_scale_factors;
-  if (n.weights) {
-    cfg.nav.fusion.weighting = *n.weights;
-    cfg.nav.fusion.weights.clear();  // over the configuration's list of fixed weights
-  }
-  if (n.calibration) cfg.calibration = *n.calibration;
-  if (o.centralized) cfg.nav.fusion.centralized = *o.centralized;
-  if (o.position_constraint) cfg.nav.fusion.position_constraint = *o.position_constraint;
-  if (o.fault_handling) cfg.nav.faults.enabled = *o.fault_handling;
-  if (o.standstill) cfg.nav.standstill.enabled = *o.standstill;
-  if (o.fixed_noise) cfg.nav.noise.enabled = !*o.fixed_noise;
-  if (o.data_checks) cfg.data_checks = *o.data_checks;
-  if (o.duration) cfg.max_duration = *o.duration;
-  if (o.output_interval) cfg.nav.output_interval = *o.output_interval;
-  if (o.covariance_interval) cfg.nav.covariance_interval = *o.covariance_interval;
-}
-
-/// Where and what is written, over the file's.
-void apply_output(const RunOverrides& o, const NamedChoices& n, RunConfig& cfg) {
-  if (!o.output_dir.empty()) cfg.output_dir = o.output_dir;
-  if (o.overwrite) cfg.overwrite = true;
-  if (o.full_rate) cfg.file_interval = 0.0;
-  if (o.subsystems) cfg.write_subsystems = true;
-  if (!n.formats.empty()) cfg.formats = n.formats;
-  if (n.tum_frame) cfg.tum_frame = *n.tum_frame;
 }
 
 }  // namespace
 
 RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
-  // The front end's own values first (numbers in range, names known), then the files.
-  check_override_numbers(o);
-  const NamedChoices named = named_choices(o);
+  // The front end's own values first (in range, names known): a mistake stops the command
+  // before it reads any file.
+  check_selection(o.named);
+  RunConfig checked;
+  apply_named(o.named, checked);
   // The file and the --set settings over it, both parsed before either is read: the file's
   // unknown keys are warnings, the settings' errors (a typo on the command line).
   const YAML::Node settings = settings_document(o.settings, kSettingExample);
@@ -348,12 +317,9 @@ RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn) {
   RunConfig cfg;
   if (file) read_run_config(*file, o.config.parent_path(), cfg, true);
   if (!o.settings.empty()) read_run_config(set, fs::path(), cfg, false);
-  if (!o.manifest.empty()) cfg.manifest = o.manifest;
+  apply_named(o.named, cfg);
   if (cfg.manifest.empty())
     throw InputError("no dataset: give a run configuration naming one, or a manifest (--manifest)");
-  apply_selection(o, cfg);
-  apply_choices(o, named, cfg);
-  apply_output(o, named, cfg);
   return cfg;
 }
 

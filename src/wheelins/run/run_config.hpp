@@ -47,27 +47,30 @@ RunConfig load_run_config(const std::filesystem::path& file, const WarningSink& 
 RunConfig load_run_config(const YAML::Node& settings, const std::filesystem::path& base,
                           const std::string& where, const WarningSink& warn);
 
-/// What a front end (`wheelins run`'s flags, Python's run() and Navigator()) sets over a run
-/// configuration, each setting once: an empty or unset field keeps the configuration's value.
-/// The numbers' ranges are checked with the request (validate_run_request).
+/// A front end's named option as given (`--duration 60`, Python's duration=60.0): the setting
+/// it sets (run_options.hpp: NamedOption) and the value, as text.
+struct NamedSetting {
+  std::string name;                 ///< as the user gave it ("--duration", "duration"): messages name it
+  std::string key;                  ///< the setting ("duration_s")
+  std::vector<std::string> values;  ///< the value; a list when `list`
+  bool list = false;
+};
+
+/// What a front end (`wheelins run`'s and `wheelins live`'s options, Python's run() and
+/// Navigator()) sets over a run configuration: the file, the `--set` settings over it, the named
+/// options over both.
 struct RunOverrides {
-  std::filesystem::path config;    ///< a run configuration file; empty: the defaults
-  std::filesystem::path manifest;  ///< over the configuration's dataset
-  std::string configuration;       ///< over the configuration's (and its module list)
-  std::vector<std::string> chips, modules;
-  std::filesystem::path output_dir;
-  std::vector<std::string> formats;
-  std::string tum_frame, speed, weights, yaw_scale_factors, calibration;
-  std::optional<bool> centralized, position_constraint, fault_handling, standstill, fixed_noise,
-      data_checks;
-  std::optional<double> duration, output_interval, covariance_interval;
-  bool overwrite = false;   ///< --force
-  bool full_rate = false;   ///< the trajectory files at every record
-  bool subsystems = false;  ///< also each IMU's own trajectory
+  std::filesystem::path config;     ///< a run configuration file; empty: the defaults
+  std::vector<NamedSetting> named;  ///< in the order given
   /// Any setting of docs/run-config.md as KEY=VALUE (`--set filter.speed_window_s=0.1`), over
-  /// the configuration file and under the named fields above; VALUE is YAML (`[1, 2, 1]`).
+  /// the configuration file and under the named options; VALUE is YAML (`[1, 2, 1]`).
   std::vector<std::string> settings;
 };
+
+/// The command line's `option` ("--chips", or any of its names) given `value` (ignored for an
+/// option without a value): a value with commas is a list, except a path's. InputError for an
+/// option that sets no run setting.
+NamedSetting cli_setting(const std::string& option, const std::string& value = "");
 
 /// For settings where a leftover key cannot be meant (a command line, a study's run settings):
 /// every warning of the reading is an InputError, "unknown key ignored" said as "unknown key".
@@ -77,13 +80,13 @@ WarningSink warnings_are_errors();
 /// setting for a malformed one, an unknown key (and the closest known) or a value out of range.
 void apply_run_settings(const std::vector<std::string>& settings, RunConfig& c);
 
-/// The configuration file's settings (or the defaults) with `o` over them; InputError for
-/// choices that exclude each other (modules with a configuration or chips) and for no dataset.
+/// The configuration file's settings (or the defaults) with `o` over them, every named option
+/// checked before a file is read; InputError naming the option or setting for a value out of
+/// range or unknown, for choices that exclude each other (modules with a configuration or
+/// chips) and for no dataset.
 RunConfig run_config_with(const RunOverrides& o, const WarningSink& warn);
 
 SpeedSharing speed_sharing_from_name(const std::string& name);
-/// `auto`, `held`, `constraint` or `estimated` (docs/filter.md 13.4); InputError otherwise.
-YawScaleFactorChoice yaw_scale_factors_from_name(const std::string& name);
 /// `estimate` or `manifest` (run/calibration.hpp); InputError otherwise.
 CalibrationMode calibration_mode_from_name(const std::string& name);
 /// `equal` (the paper) or `covariance` (fusion/aids/position_constraint/reference_weights.hpp); InputError otherwise.

@@ -15,14 +15,17 @@
 //   v.flag(info, b)                             true / false
 //   v.path(info, p, required, default_text)     a path, relative to the file's folder
 //   v.choice(info, e, names)                    one of named values
-//   v.custom(info, range_text, default_text, read)
+//   v.custom(info, range_text, show, read)
 //                                               its own reading: read(y, node, c, base) with the
 //                                               YamlReader, the key's node, the configuration
-//                                               and the file's folder
+//                                               and the file's folder; show(c): its value as
+//                                               text (the documentation's default is show's
+//                                               of the defaults)
 //   v.section_check(section, check)             a check of a whole section once it is read
 //                                               (check(c) throws InputError)
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -55,6 +58,13 @@ inline constexpr OptionScale kDegrees{kDeg, 1.0};
 template <class E>
 using OptionChoices = std::vector<std::pair<std::string, E>>;
 
+/// A custom setting's value as text (run_options_listing, the documentation's default).
+using OptionShow = std::string (*)(const RunConfig&);
+/// A number as the documentation and the listing write it: 10⁻⁴, 10⁶, or printf's %g.
+std::string option_number(double x);
+/// "a, b, c".
+std::string option_list(const std::vector<std::string>& items);
+
 /// The named choices shared by the file and the command line (run_config.cpp's *_from_name).
 const OptionChoices<SpeedSharing>& speed_sharing_choices();
 const OptionChoices<YawScaleFactorChoice>& yaw_scale_factor_choices();
@@ -69,25 +79,54 @@ OptionRange run_option_range(const std::string& key);
 /// range, default, meaning; a test keeps the documentation equal to it.
 std::string run_options_markdown();
 
+/// Every setting of `c` as `wheelins run -v` lists it: key, value (and unit), and the default
+/// where the value is another.
+std::string run_options_listing(const RunConfig& c);
+
+/// A front end's named option over one declared setting, made from the declaration's `cli`
+/// text: `wheelins run`'s and `wheelins live`'s options, Python's keywords. The text is the
+/// option's names (CLI11's "--out,-o") and, for an option that takes no value, what it sets:
+/// "(off)" false, "(= 0)" that value; a flag setting without either sets true.
+struct NamedOption {
+  std::string names;    ///< "--no-position-constraint", "--out,-o"
+  std::string option;   ///< the long name: "--out"
+  std::string keyword;  ///< Python's: "out"; "position_constraint" for "--no-position-constraint"
+  std::string key;      ///< the setting: "fusion.position_constraint"
+  std::string help;     ///< the declaration's, with its range and default
+  std::string sets;     ///< an option without a value: what it sets ("false", "0"); empty: a value
+  bool path = false;    ///< a path: its value never split at commas
+  /// The setting's value for Python's keyword given True or False (an option without a value):
+  /// position_constraint=False sets false, fixed_noise=True false, full_rate=False nothing.
+  std::optional<std::string> keyword_value(bool given) const;
+};
+
+/// Every setting that has a front end's option, in the order of the file.
+const std::vector<NamedOption>& run_named_options();
+/// The named option with this long name ("--duration") or keyword ("duration"); nullptr if none.
+const NamedOption* find_named_option(const std::string& name);
+
 /// The top-level keys.
 template <class V>
 void declare_selection_options(V& v, RunConfig& c) {
-  v.path({"dataset", "the dataset manifest (relative to this file)", "--manifest"}, c.manifest, true,
+  v.path({"dataset", "the dataset manifest (relative to this file)", "--manifest,-m"}, c.manifest, true,
          "required");
-  v.custom({"configuration", "which IMUs: a configuration of the dataset's chips", "--configuration"},
-           "single, single-right, dual-wheel, body-wheel, triple, ...", c.configuration.c_str(),
+  v.custom({"configuration", "which IMUs: a configuration of the dataset's chips", "--configuration,-c"},
+           "single, single-right, dual-wheel, body-wheel, triple, ...", [](const RunConfig& r) { return r.configuration; },
            [](const auto& y, const auto& n, RunConfig& r, const auto&) {
              r.configuration = y.text(n, "configuration");
              bool known = r.configuration == "single-right";
              for (const auto& name : configuration_names()) known = known || name == r.configuration;
              if (!known) y.fail("configuration", "unknown configuration '" + r.configuration + "'", &n);
+             r.modules.clear();  // over modules given before (a file's, under --configuration)
            });
   v.custom({"chips", "one chip per IMU of the configuration (left, right, body order)", "--chips"}, "a list",
-           "the configuration's first chips",
+           [](const RunConfig& r) { return r.chips.empty() ? "the configuration's first chips" : option_list(r.chips); },
            [](const auto& y, const auto& n, RunConfig& r, const auto&) { r.chips = y.text_list(n, "chips"); });
-  v.custom({"modules", "the modules by name, instead of a configuration", "--modules"}, "a list", "none",
+  v.custom({"modules", "the modules by name, instead of a configuration", "--modules"}, "a list",
+           [](const RunConfig& r) { return r.modules.empty() ? "none" : option_list(r.modules); },
            [](const auto& y, const auto& n, RunConfig& r, const auto&) { r.modules = y.text_list(n, "modules"); });
-  v.custom({"duration_s", "stop after this much navigation", "--duration"}, "(0, 10⁷] s", "all the data",
+  v.custom({"duration_s", "stop after this much navigation", "--duration"}, "(0, 10⁷] s",
+           [](const RunConfig& r) { return r.max_duration > 0 ? option_number(r.max_duration) : "all the data"; },
            [](const auto& y, const auto& n, RunConfig& r, const auto&) {
              r.max_duration = y.number_in(n, "duration_s", 0.0, 1e7, "s");
              if (r.max_duration <= 0) y.fail("duration_s", "must be > 0 s (leave it out for all the data)", &n);
@@ -104,9 +143,14 @@ void declare_selection_options(V& v, RunConfig& c) {
 /// output: what is written where.
 template <class V>
 void declare_output_options(V& v, RunConfig& c) {
-  v.path({"output.dir", "the results directory (relative to this file)", "-o"}, c.output_dir, false,
+  v.path({"output.dir", "the results directory (relative to this file)", "--out,-o"}, c.output_dir, false,
          "results/CONFIGURATION[-chips]");
-  v.custom({"output.formats", "the trajectory files", "--formats"}, "csv, tum, kml (a list)", "[csv, tum, kml]",
+  v.custom({"output.formats", "the trajectory files", "--formats"}, "csv, tum, kml (a list)",
+           [](const RunConfig& r) {
+             std::vector<std::string> names;
+             for (const TrajectoryFormat f : r.formats) names.emplace_back(trajectory_format_name(f));
+             return "[" + option_list(names) + "]";
+           },
            [](const auto& y, const auto& n, RunConfig& r, const auto&) {
              r.formats.clear();
              for (const auto& f : y.text_list(n, "output.formats")) {
@@ -118,7 +162,8 @@ void declare_output_options(V& v, RunConfig& c) {
   v.custom({"output.tum_frame",
             "trajectory.tum in ned (x north, y east, z down) or enu (x east, y north, z up: ROS, evo)",
             "--tum-frame"},
-           "ned or enu", "ned", [](const auto& y, const auto& n, RunConfig& r, const auto&) {
+           "ned or enu", [](const RunConfig& r) { return std::string(r.tum_frame == TumFrame::kEnu ? "enu" : "ned"); },
+           [](const auto& y, const auto& n, RunConfig& r, const auto&) {
              const std::string f = y.text(n, "output.tum_frame");
              if (f != "ned" && f != "enu") y.fail("output.tum_frame", "'" + f + "': expected ned or enu", &n);
              r.tum_frame = tum_frame_from_name(f);
@@ -131,7 +176,7 @@ void declare_output_options(V& v, RunConfig& c) {
   v.number({"output.file_interval_s", "the records written to the trajectory files (and the last one)",
             "--full-rate (= 0)"},
            c.file_interval, {0.0, 5.0, "s (0 = every record)"});
-  v.flag({"output.overwrite", "replace earlier results (only the files wheelins wrote)", "--force"}, c.overwrite);
+  v.flag({"output.overwrite", "replace earlier results (only the files wheelins wrote)", "--force,-f"}, c.overwrite);
   v.flag({"output.subsystems", "also MODULE.csv for each subsystem", "--subsystems"}, c.write_subsystems);
 }
 
@@ -149,7 +194,8 @@ void declare_filter_options(V& v, RunConfig& c) {
            n.yaw_scale_factors, yaw_scale_factor_choices());
   v.custom({"filter.estimate_yaw_scale_factors", "the older spelling: true = estimated, false = held (not with "
             "filter.yaw_scale_factors)", ""},
-           "true or false", "not given", [](const auto& y, const auto& node, RunConfig& r, const auto&) {
+           "true or false", [](const RunConfig&) { return std::string("not given"); },
+           [](const auto& y, const auto& node, RunConfig& r, const auto&) {
              if (y.get(y.get(y.root(), "filter"), "yaw_scale_factors").IsDefined())
                y.fail("filter.estimate_yaw_scale_factors",
                       "conflicts with filter.yaw_scale_factors (give only the latter)", &node);
@@ -215,7 +261,17 @@ void declare_fusion_options(V& v, RunConfig& c) {
             "section 14) | standalone (each subsystem's drift without the constraint, section 14.1) | a list, "
             "one per module (normalised)",
             "--weights"},
-           "a name, or a list with each in (0, 10⁶] (leave a module out rather than weight it 0)", "equal",
+           "a name, or a list with each in (0, 10⁶] (leave a module out rather than weight it 0)", [](const RunConfig& r) {
+             if (!r.nav.fusion.weights.empty()) {
+               std::vector<std::string> w;
+               for (const double x : r.nav.fusion.weights) w.push_back(option_number(x));
+               return "[" + option_list(w) + "]";
+             }
+             const ReferenceWeighting k = r.nav.fusion.weighting;
+             return std::string(k == ReferenceWeighting::kCovariance   ? "covariance"
+                                : k == ReferenceWeighting::kStandalone ? "standalone"
+                                                                       : "equal");
+           },
            [](const auto& y, const auto& node, RunConfig& r, const auto&) {
              FusionOptions& o = r.nav.fusion;
              if (node.IsScalar()) {
@@ -224,6 +280,7 @@ void declare_fusion_options(V& v, RunConfig& c) {
                         "expected equal, covariance or standalone (or a list of one positive weight per "
                         "module), got " + y.describe(node), &node);
                o.weighting = weighting_from_name(node.Scalar());
+               o.weights.clear();  // over a list given before (a file's, under --weights)
                return;
              }
              o.weights = y.number_list(node, "fusion.weights");
