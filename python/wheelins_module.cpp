@@ -199,6 +199,9 @@ std::string keyword_text(const std::string& keyword, const py::handle& v) {
   if (py::isinstance<py::int_>(v)) return py::str(v).cast<std::string>();
   if (py::isinstance<py::float_>(v)) return py::repr(py::float_(py::reinterpret_borrow<py::object>(v))).cast<std::string>();
   if (py::isinstance<py::str>(v) || py::hasattr(v, "__fspath__")) return *text(py::reinterpret_borrow<py::object>(v));
+  if (py::hasattr(v, "__index__")) return py::str(py::int_(py::reinterpret_borrow<py::object>(v))).cast<std::string>();
+  if (py::hasattr(v, "__float__"))  // numpy's numbers
+    return py::repr(py::float_(py::reinterpret_borrow<py::object>(v))).cast<std::string>();
   throw InputError(keyword + ": expected a number, a text, True or False, got " + py::repr(v).cast<std::string>());
 }
 

@@ -145,7 +145,8 @@ def test_keywords_are_the_options_of_wheelins_run(dataset, tmp_path):
         "--no-standstill", "--no-data-checks", "--tum-frame", "enu", "--no-fault-handling", "--full-rate", "-q")
     same_as_csv(r.trajectory, read_csv(tmp_path / "cli" / "trajectory.csv"))
     assert (tmp_path / "py" / "trajectory.tum").read_text() == (tmp_path / "cli" / "trajectory.tum").read_text()
-    nav = wheelins.Navigator(dataset["manifest"], configuration="dual-wheel", standstill=False, weights="covariance")
+    nav = wheelins.Navigator(dataset["manifest"], configuration="dual-wheel", standstill=False, weights="covariance",
+                             duration=np.float32(15.0), output_interval=np.int64(0))  # numpy's numbers too
     assert nav.modules == r.modules
     with pytest.raises(wheelins.InputError, match=r"^duration: duration_s: must be > 0 s"):
         wheelins.run(dataset["manifest"], duration=0.0)

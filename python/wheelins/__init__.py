@@ -49,8 +49,9 @@ _RUN_KEYWORDS = dict(_core.run_keywords())  # keyword -> the setting's key (docs
 _NAMED = ("manifest", "configuration", "chips", "modules")
 _RUN_SETTINGS = tuple(k for k in _RUN_KEYWORDS if k not in _NAMED + ("out", "formats", "force", "full_rate",
                                                                       "subsystems")) + ("settings",)
-_NAVIGATOR_SETTINGS = tuple(k for k, key in _RUN_KEYWORDS.items()
-                            if k not in _NAMED and not key.startswith("output.")) + ("calibration_warmup", "settings")
+_NAVIGATOR_SETTINGS = tuple(k for k, key in _RUN_KEYWORDS.items()  # not the files' (a Navigator writes none)
+                            if k not in _NAMED and (key == "output.interval_s" or not key.startswith("output."))
+                            ) + ("calibration_warmup", "settings")
 _EVALUATE_OPTIONS = ("format", "truth_layout", "segment", "max_gap", "align", "origin")
 
 

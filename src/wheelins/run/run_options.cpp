@@ -1,8 +1,9 @@
-// The documentation's table of the run settings, from their declarations (run_options.hpp).
+// From the run settings' declarations (run_options.hpp): the documentation's table, the listing of
+// `wheelins run -v`, and the front ends' named options (the command line's and Python's keywords).
 #include "wheelins/run/run_options.hpp"
 
-#include <cctype>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <optional>

@@ -1,8 +1,10 @@
 // Every setting of a run configuration (docs/run-config.md), declared once: its key, its range
 // and unit, how the file's number becomes the filters' value, the command-line option that sets
 // it too, its default (the RunConfig's own) and what it means. Reading the YAML file (keys,
-// types, ranges, the checks of a whole section), and the documentation's table of settings
-// walk this one list: a setting added here is read, checked and documented.
+// types, ranges, the checks of a whole section), the documentation's table of settings, the
+// listing of `wheelins run -v`, and the named options of `wheelins run` and `wheelins live` and
+// Python's keywords walk this one list: a setting added here is read, checked, documented,
+// listed and, with a `cli` text, an option and a keyword.
 //
 // declare_run_options(v, c) calls one method of the visitor `v` per setting, in the order of
 // the file (the top-level keys, output, filter, fusion, noise, standstill, faults):
