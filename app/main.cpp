@@ -40,9 +40,9 @@ void add_run_setting_options(CLI::App& sub, std::vector<NamedSetting>& named) {
   for (const NamedOption& o : run_named_options()) {
     if (o.sets.empty())
       sub.add_option_function<std::string>(
-          o.names, [&named, &o](const std::string& v) { named.push_back(cli_setting(o.option, v)); }, o.help);
+          o.names, [&named, &o](const std::string& v) { named.push_back(cli_setting(o, v)); }, o.help);
     else
-      sub.add_flag_callback(o.names, [&named, &o] { named.push_back(cli_setting(o.option)); }, o.help);
+      sub.add_flag_callback(o.names, [&named, &o] { named.push_back(cli_setting(o)); }, o.help);
   }
 }
 

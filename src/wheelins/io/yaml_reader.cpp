@@ -190,6 +190,25 @@ std::vector<std::string> dotted_key_parts(const std::string& key) {
   }
 }
 
+void set_dotted_key(YAML::Node root, const std::string& key, const YAML::Node& value, const std::string& where) {
+  const std::vector<std::string> parts = dotted_key_parts(key);
+  YAML::Node map = root;
+  std::string path;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const std::string& name = parts[k];
+    if (name.empty()) throw InputError(where + ": an empty part in the key '" + key + "'");
+    path += (path.empty() ? "" : ".") + name;
+    if (k + 1 == parts.size()) {
+      if (map[name].IsDefined() && !map[name].IsNull()) throw InputError(where + ": " + key + " is set twice");
+      map[name] = value;
+      return;
+    }
+    if (!map[name].IsDefined() || map[name].IsNull()) map[name] = YAML::Node(YAML::NodeType::Map);
+    if (!map[name].IsMap()) throw InputError(where + ": " + path + " is set as a value and as a section");
+    map.reset(map[name]);
+  }
+}
+
 YAML::Node settings_document(const std::vector<std::string>& settings, const std::string& expected) {
   YAML::Node root(YAML::NodeType::Map);
   for (const std::string& s : settings) {
@@ -199,23 +218,7 @@ YAML::Node settings_document(const std::vector<std::string>& settings, const std
       throw InputError(where + ": expected KEY=VALUE, " + expected);
     const YAML::Node value = parse_yaml(s.substr(eq + 1), where, "value");
     if (!value.IsDefined() || value.IsNull()) throw InputError(where + ": no value after '='");
-    const std::string key = s.substr(0, eq);
-    const std::vector<std::string> parts = dotted_key_parts(key);
-    YAML::Node map = root;
-    std::string path;
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      const std::string& name = parts[k];
-      if (name.empty()) throw InputError(where + ": an empty part in the key '" + key + "'");
-      path += (path.empty() ? "" : ".") + name;
-      if (k + 1 == parts.size()) {
-        if (map[name].IsDefined() && !map[name].IsNull()) throw InputError(where + ": " + key + " is set twice");
-        map[name] = value;
-        break;
-      }
-      if (!map[name].IsDefined() || map[name].IsNull()) map[name] = YAML::Node(YAML::NodeType::Map);
-      if (!map[name].IsMap()) throw InputError(where + ": " + path + " is set as a value and as a section");
-      map.reset(map[name]);
-    }
+    set_dotted_key(root, s.substr(0, eq), value, where);
   }
   return root;
 }

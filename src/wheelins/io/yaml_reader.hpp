@@ -28,6 +28,11 @@ YAML::Node parse_yaml(const std::string& text, const std::string& where, const s
 /// "filter.initial_std.heading_deg" -> {filter, initial_std, heading_deg} (empty parts kept).
 std::vector<std::string> dotted_key_parts(const std::string& key);
 
+/// Puts `value` at the dotted `key` of the map `root`, making the maps on its way: {a: {b: value}}
+/// for "a.b". InputError naming `where` for an empty part in the key, a key set twice, or one set
+/// as a value and as a section.
+void set_dotted_key(YAML::Node root, const std::string& key, const YAML::Node& value, const std::string& where);
+
 /// `KEY=VALUE` settings (`--set filter.speed_window_s=0.1`: a dotted key, a YAML value read by
 /// parse_yaml) as one document: {filter: {speed_window_s: 0.1}, ...}. InputError naming the
 /// setting for one without '=' (saying `expected`, e.g. "a key of docs/run-config.md"), without

@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 
+#include "wheelins/io/text_util.hpp"
 #include "wheelins/io/yaml_reader.hpp"
 #include "wheelins/run/presets.hpp"
 #include "wheelins/run/run_options.hpp"
@@ -234,26 +235,25 @@ RunConfig load_run_config(const YAML::Node& settings, const fs::path& base, cons
   return read_run_config(y, base);
 }
 
-NamedSetting cli_setting(const std::string& option, const std::string& value) {
-  const NamedOption* o = nullptr;
-  for (const NamedOption& n : run_named_options())
-    if (("," + n.names + ",").find("," + option + ",") != std::string::npos) o = &n;
-  if (!o) throw InputError(option + ": not an option of a run setting");
-  NamedSetting s{o->option, o->key, {}, false};
-  if (!o->sets.empty()) {
-    s.values = {o->sets};
-  } else if (o->path || value.find(',') == std::string::npos) {
+NamedSetting cli_setting(const NamedOption& o, const std::string& value) {
+  NamedSetting s{o.option, o.key, {}, false};
+  if (!o.sets.empty()) {
+    s.values = {o.sets};
+  } else if (o.path || value.find(',') == std::string::npos) {
     s.values = {value};
   } else {
-    s.list = true;
-    for (std::size_t start = 0;;) {  // "a,b,,c": each item, empty ones too (the reading names them)
-      const std::size_t k = value.find(',', start);
-      s.values.push_back(value.substr(start, k == std::string::npos ? std::string::npos : k - start));
-      if (k == std::string::npos) break;
-      start = k + 1;
-    }
+    s.list = true;  // "a,b,,c": each item, empty ones too (the reading names them)
+    std::vector<std::string_view> items;
+    io_detail::split_fields(value, ',', items);
+    s.values.assign(items.begin(), items.end());
   }
   return s;
+}
+
+NamedSetting cli_setting(const std::string& option, const std::string& value) {
+  for (const NamedOption& n : run_named_options())
+    if (("," + n.names + ",").find("," + option + ",") != std::string::npos) return cli_setting(n, value);
+  throw InputError(option + ": not an option of a run setting");
 }
 
 namespace {
@@ -261,19 +261,13 @@ namespace {
 /// The named options read over `c`, one by one so that a message names the option.
 void apply_named(const std::vector<NamedSetting>& named, RunConfig& c) {
   for (const NamedSetting& s : named) {
-    YAML::Node doc(YAML::NodeType::Map);
-    YAML::Node at = doc;
-    const std::vector<std::string> parts = dotted_key_parts(s.key);
-    for (std::size_t k = 0; k + 1 < parts.size(); ++k) {
-      at[parts[k]] = YAML::Node(YAML::NodeType::Map);
-      at.reset(at[parts[k]]);
-    }
     YAML::Node value;
     if (s.list)
       for (const std::string& v : s.values) value.push_back(v);
     else
       value = s.values.empty() ? std::string() : s.values.front();
-    at[parts.back()] = value;
+    YAML::Node doc(YAML::NodeType::Map);
+    set_dotted_key(doc, s.key, value, s.name);
     try {
       const YamlReader y(doc, s.name, warnings_are_errors(), false);
       read_run_config(y, fs::path(), c, false);

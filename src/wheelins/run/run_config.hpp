@@ -71,6 +71,9 @@ struct RunOverrides {
 /// option without a value): a value with commas is a list, except a path's. InputError for an
 /// option that sets no run setting.
 NamedSetting cli_setting(const std::string& option, const std::string& value = "");
+/// The same for the option itself (run_options.hpp: run_named_options).
+struct NamedOption;
+NamedSetting cli_setting(const NamedOption& option, const std::string& value = "");
 
 /// For settings where a leftover key cannot be meant (a command line, a study's run settings):
 /// every warning of the reading is an InputError, "unknown key ignored" said as "unknown key".
