@@ -124,7 +124,7 @@ LiveStream::LiveStream(PushSession& session, const LiveStreamOptions& options, s
   values_.assign(header_.size(), 0.0);
   text_.reserve(64 * header_.size());
   stats_.latency.reserve(1u << 16);  // 6.5 h of states at 10 Hz before it grows
-  if (options_.csv) {
+  if (options_.csv && !options_.on_state) {
     std::string h;
     for (std::size_t k = 0; k < header_.size(); ++k) h += (k ? "," : "") + header_[k];
     std::fprintf(out_, "%s\n", h.c_str());
@@ -161,7 +161,7 @@ bool LiveStream::line(std::string_view text, double arrival) {
     if (!parse_stream_line(text, l)) return true;
   } catch (const InputError& e) {
     ++stats_.bad_lines;
-    report(kBadLine, options_.source + " line " + std::to_string(number) + ": " + e.what());
+    report(kBadLine, where(number) + ": " + e.what());
     return true;
   }
   const int m = module_index(l.module);
@@ -169,17 +169,29 @@ bool LiveStream::line(std::string_view text, double arrival) {
     ++stats_.bad_lines;
     std::string list;
     for (const auto& n : names_) list += (list.empty() ? "" : ", ") + n;
-    report(kBadLine, options_.source + " line " + std::to_string(number) + ": module '" + std::string(l.module) +
+    report(kBadLine, where(number) + ": module '" + std::string(l.module) +
                          "' is not navigated (modules: " + list + ", or their index 0.." +
                          std::to_string(names_.size() - 1) + ")");
     return true;
   }
-  const double key = l.row.t + offsets_[static_cast<std::size_t>(m)];
-  if (!window_.offer(key, m, number, l.row)) {
+  return offer(m, l.row, arrival, number);
+}
+
+bool LiveStream::sample(int module, const ImuRow& row, double arrival) {
+  const std::uint64_t number = ++stats_.lines;
+  if (stopped_) return false;
+  if (module < 0 || module >= static_cast<int>(names_.size()))
+    throw InputError("LiveStream::sample: module index " + std::to_string(module) + " out of range");
+  return offer(module, row, arrival, number);
+}
+
+bool LiveStream::offer(int m, const ImuRow& row, double arrival, std::uint64_t number) {
+  const double key = row.t + offsets_[static_cast<std::size_t>(m)];
+  if (!window_.offer(key, m, number, row)) {
     ++stats_.late;
-    report(kLate, options_.source + " line " + std::to_string(number) + ": module '" + names_[static_cast<std::size_t>(m)] +
-                      "' at t = " + format_double(l.row.t) + " s arrived after the reorder window (" +
-                      format_double(window_.window()) + " s) had passed it: dropped");
+    report(kLate, where(number) + ": module '" + names_[static_cast<std::size_t>(m)] + "' at t = " +
+                      format_double(row.t) + " s arrived after the reorder window (" + format_double(window_.window()) +
+                      " s) had passed it: dropped");
     return true;
   }
   const std::uint64_t before = stats_.published;
@@ -187,6 +199,16 @@ bool LiveStream::line(std::string_view text, double arrival) {
   while (!stopped_ && window_.pop_due(item)) stopped_ = !navigate(item);
   if (stats_.published > before) stats_.latency.push_back(now_seconds() - arrival);
   return !stopped_;
+}
+
+void LiveStream::refuse(const std::string& what) {
+  const std::uint64_t number = ++stats_.lines;
+  ++stats_.bad_lines;
+  report(kBadLine, where(number) + ": " + what);
+}
+
+std::string LiveStream::where(std::uint64_t number) const {
+  return options_.source + " " + options_.unit + " " + std::to_string(number);
 }
 
 void LiveStream::end() {
@@ -203,7 +225,7 @@ bool LiveStream::navigate(const ReorderWindow::Item& item) {
     ++stats_.samples;
   } catch (const RejectedSample& e) {
     ++stats_.rejected;
-    report(kRejected, options_.source + " line " + std::to_string(item.line) + ": " + e.what() + ": dropped");
+    report(kRejected, where(item.line) + ": " + e.what() + ": dropped");
     return true;
   }
   if (session_.in_warmup()) {
@@ -234,8 +256,14 @@ bool LiveStream::navigate(const ReorderWindow::Item& item) {
   return more;
 }
 
-// The vehicle's state now, as a JSON object or a CSV row (the trajectory CSV's columns).
+// The vehicle's state now, as a JSON object or a CSV row (the trajectory CSV's columns), or
+// given to options_.on_state.
 void LiveStream::publish() {
+  if (options_.on_state) {
+    options_.on_state(session_.navigator().vehicle_record());
+    ++stats_.published;
+    return;
+  }
   trajectory_csv_values(session_.navigator().vehicle_record(), values_.data());
   text_.clear();
   char buf[64];

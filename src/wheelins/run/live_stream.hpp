@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -68,11 +69,15 @@ struct LiveStreamOptions {
   bool csv = false;                ///< CSV rows (a header first) instead of JSON lines
   int reports_per_kind = 5;        ///< bad input: the first this many of each kind reported
   std::string source = "standard input";///< names the stream in messages
+  std::string unit = "line";            ///< what the stream's records are called in messages
+  /// Where the states go instead of the text output (the ROS node's odometry): called with
+  /// the vehicle's state at each publication. Empty: JSON lines or CSV rows to `out`.
+  std::function<void(const TrajectoryRecord&)> on_state;
 };
 
 /// What the stream saw, for the summary.
 struct LiveStreamStats {
-  std::uint64_t lines = 0;       ///< lines read (comments and blank lines included)
+  std::uint64_t lines = 0;       ///< lines (or messages) read (comments and blank lines included)
   std::uint64_t samples = 0;     ///< samples passed to the navigation
   std::uint64_t bad_lines = 0;   ///< not readable, not finite, a module not navigated
   std::uint64_t late = 0;        ///< older than the reorder window
@@ -94,6 +99,16 @@ class LiveStream {
   /// One line as it arrived (`number` from 1), `arrival` its steady-clock time [s]. False once
   /// the request's duration is reached (read no more).
   bool line(std::string_view text, double arrival);
+  /// One sample of module `module` (its index in the request's modules) as it arrived, from
+  /// a source that is not text (a ROS message; it was checked to be finite); reports name it
+  /// as "SOURCE UNIT NUMBER" (LiveStreamOptions: "ROS topics message 12"). Otherwise as line().
+  bool sample(int module, const ImuRow& row, double arrival);
+  /// A record of a source that is not text that cannot be navigated (a value not finite, a
+  /// wrong frame id): counted as unreadable and reported as line() reports a bad line.
+  void refuse(const std::string& what);
+  /// The module's index in the request's modules (or its index as a number); -1 if none.
+  int module_index(std::string_view name) const;
+  const std::vector<std::string>& modules() const { return names_; }
   /// The end of the stream: the window emptied into the navigation (the session is not
   /// finished here).
   void end();
@@ -104,7 +119,8 @@ class LiveStream {
   void report(Kind kind, const std::string& message);
   bool navigate(const ReorderWindow::Item& item);
   void publish();
-  int module_index(std::string_view name) const;
+  bool offer(int module, const ImuRow& row, double arrival, std::uint64_t number);
+  std::string where(std::uint64_t number) const;
 
   PushSession& session_;
   LiveStreamOptions options_;
