@@ -265,10 +265,13 @@ int live(const LiveArgs& a) {
 #if WHEELINS_HAVE_ROS_LIVE
 // ----------------------------------------------------------------------------- ROS 1 node
 
-/// The node's settings: its private parameters (a YAML file loaded by the launch file) over
-/// the command line's defaults; `settings.KEY` parameters are run settings (as --set KEY=VALUE,
-/// before the command line's --set), `topics.MODULE` a module's topic (default MODULE/imu,
-/// in the node's namespace), `frame_ids.MODULE` the frame id its messages must carry.
+/// The node's settings: its private parameters (a YAML file loaded by the launch file).
+/// `settings.KEY` parameters are run settings, under the command line's (as --set KEY=VALUE
+/// before the command line's --set and named options); `config` a run configuration file when
+/// the command line names none; `topics.MODULE` a module's topic (default NAME/imu, a ROS
+/// name, in the node's namespace); `frame_ids.MODULE` the frame id its messages must carry;
+/// the others go over the command line's --window, --publish-interval, --calibration-warmup
+/// and --idle-exit.
 struct RosParams {
   ros1::NodeSetup setup;
   std::map<std::string, std::string> topics, frame_ids;
@@ -307,7 +310,7 @@ RosParams read_ros_params(const ros1::Node& node, LiveArgs& a) {
     if (top == "settings" && !sub.empty()) settings.push_back(sub + "=" + value);
     else if (top == "topics" && !sub.empty()) p.topics[sub] = value;
     else if (top == "frame_ids" && !sub.empty()) p.frame_ids[sub] = value;
-    else if (key == "config") a.config_file = value;
+    else if (key == "config") a.config_file = a.config_file.empty() ? value : a.config_file;
     else if (key == "odom_topic") p.setup.odom_topic = value;
     else if (key == "odom_frame") p.setup.odom_frame = value;
     else if (key == "base_frame") p.setup.base_frame = value;
@@ -388,11 +391,10 @@ std::vector<ros1::Diagnostic> diagnostics(const PushSession& session, const Live
     } else {
       d.message = "ok";
     }
-    for (const auto& w : wrong)
-      if (w.rfind(t.topic + " ", 0) == 0 || w.find(t.topic) != std::string::npos) {
-        d.level = ros1::Diagnostic::kError;
-        d.message = "a publisher on " + w + ": the node takes sensor_msgs/Imu";
-      }
+    if (i < wrong.size() && !wrong[i].empty()) {
+      d.level = ros1::Diagnostic::kError;
+      d.message = "a publisher on " + t.topic + " of type " + wrong[i] + ": the node takes sensor_msgs/Imu";
+    }
     d.values = {{"messages", std::to_string(t.received)},
                 {"refused", std::to_string(t.refused)},
                 {"last stamp [s]", io_detail::format_double(t.last_stamp)},

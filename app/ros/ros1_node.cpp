@@ -224,13 +224,13 @@ void RosNode::publish(const std::vector<Diagnostic>& status, double stamp) {
 }
 
 std::vector<std::string> RosNode::wrong_types() const {
-  std::vector<std::string> out;
+  std::vector<std::string> out(impl_->setup.topics.size());
   ros::master::V_TopicInfo topics;
   if (!ros::master::getTopics(topics)) return out;
-  for (const auto& want : impl_->setup.topics) {
-    const std::string resolved = ros::names::resolve(want);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::string resolved = ros::names::resolve(impl_->setup.topics[i]);
     for (const auto& info : topics)
-      if (info.name == resolved && info.datatype != "sensor_msgs/Imu") out.push_back(resolved + " (" + info.datatype + ")");
+      if (info.name == resolved && info.datatype != "sensor_msgs/Imu") out[i] = info.datatype;
   }
   return out;
 }

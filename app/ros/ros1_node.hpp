@@ -67,7 +67,8 @@ class Node {
   virtual void publish(const Odometry& odom) = 0;
   /// The statuses as one diagnostic_msgs/DiagnosticArray stamped `stamp` (<= 0: ROS's now).
   virtual void publish(const std::vector<Diagnostic>& status, double stamp) = 0;
-  /// Topics that have a publisher with a type other than sensor_msgs/Imu: "topic (type)".
+  /// For each subscribed topic (NodeSetup::topics' order): the type the master lists for it
+  /// when that is not sensor_msgs/Imu (a publisher of another type), else empty.
   virtual std::vector<std::string> wrong_types() const = 0;
 };
 

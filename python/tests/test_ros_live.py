@@ -270,7 +270,7 @@ def test_a_topic_that_stops_and_bad_messages_get_diagnostics_and_the_odometry_go
     statuses = [s for m in msgs["/diagnostics"] for s in m.status if s.name == "wheelins: body-C1"]
     assert any(s.level == 2 and "no message on body_C1/imu" in s.message for s in statuses), \
         [s.message for s in statuses]
-    assert any(s.level == 2 and "std_msgs/String" in s.message for s in statuses), [s.message for s in statuses]
+    assert any(s.level == 2 and "of type std_msgs/String" in s.message for s in statuses), [s.message for s in statuses]
     nav = [s for m in msgs["/diagnostics"] for s in m.status if s.name == "wheelins: navigation"]
     assert nav[-1].level == 1  # input was left out
 
