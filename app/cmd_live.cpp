@@ -276,8 +276,9 @@ struct RosParams {
   ros1::NodeSetup setup;
   std::map<std::string, std::string> topics, frame_ids;
   double stale_after = 1.0;  ///< [s] without a message before a topic's diagnostic is an error
-  double diagnostics_period = 1.0;
 };
+
+constexpr double kDiagnosticsPeriod = 1.0;  ///< [s] of wall time between the node's diagnostics
 
 double param_number(const std::string& node, const std::string& key, const std::string& text, double lo, double hi) {
   double v = 0.0;
@@ -421,7 +422,7 @@ std::string refusal(const ros1::ImuMessage& m, const TopicState& t, const std::m
   static const char* const names[6] = {"angular_velocity.x", "angular_velocity.y", "angular_velocity.z",
                                        "linear_acceleration.x", "linear_acceleration.y", "linear_acceleration.z"};
   const std::string at = t.topic + " seq " + std::to_string(m.seq) + ": ";
-  if (!std::isfinite(m.t) || m.t <= 0.0) return at + "header.stamp is 0";
+  if (!(m.t > 0.0) || !std::isfinite(m.t)) return at + "header.stamp " + io_detail::format_double(m.t) + " is not a time";
   for (int k = 0; k < 6; ++k) {
     const double v = k < 3 ? m.gyro[k] : m.accel[k - 3];
     if (!std::isfinite(v)) return at + names[k] + " is " + (std::isnan(v) ? "NaN" : "infinite");
@@ -512,7 +513,7 @@ int live_ros(LiveArgs a, const std::vector<std::string>& ros_args) {
     if (now >= next_diag) {
       wrong = node.wrong_types();
       node.publish(diagnostics(session, stream, topics, wrong, now, p.stale_after), 0.0);
-      next_diag = now + p.diagnostics_period;
+      next_diag = now + kDiagnosticsPeriod;
     }
     // From the first message on: a node waits for its topics as long as it takes.
     if (a.idle_exit > 0.0 && last_input > 0.0 && now - last_input > a.idle_exit) {

@@ -34,8 +34,6 @@ struct OdometryState {
 class OdometryFrame {
  public:
   OdometryState operator()(const TrajectoryRecord& r);
-  bool started() const { return started_; }
-  void reset() { started_ = false; }
 
  private:
   bool started_ = false;
