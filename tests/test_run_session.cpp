@@ -193,3 +193,37 @@ TEST_F(RunSessionTest, TheRunsEvaluationIsTheOneEveryFrontEndGets) {
 }
 
 }  // namespace
+
+TEST_F(RunSessionTest, AWarmUpsKeptSamplesNavigatedASliceAtATimeGiveTheSameRun) {
+  // All at once (0), a slice of 200 per push (caught up inside the data) and 1 per push (never
+  // caught up: finish() navigates the rest): the same files to the byte.
+  std::vector<std::string> trajectories;
+  for (const std::size_t slice : {std::size_t{0}, std::size_t{200}, std::size_t{1}}) {
+    SCOPED_TRACE(slice);
+    const fs::path out = dir_->path() / ("catch-up-" + std::to_string(slice));
+    RunRequest r = request("body-wheel", out);
+    r.calibration = CalibrationMode::kEstimate;
+    PushSession s(r, 5.0);
+    s.set_catch_up(slice);
+    std::size_t pushes_behind = 0;
+    for (const auto& [i, row] : merged_rows(r)) {
+      ASSERT_TRUE(s.push(i, row));
+      if (s.behind()) ++pushes_behind;
+      EXPECT_FALSE(s.behind() && s.in_warmup());
+    }
+    if (slice == 0) {
+      EXPECT_EQ(pushes_behind, 0u);
+    } else if (slice == 200) {
+      EXPECT_GT(pushes_behind, 10u);
+      EXPECT_FALSE(s.behind());
+    } else {
+      EXPECT_TRUE(s.behind());
+    }
+    s.finish();
+    EXPECT_FALSE(s.behind());
+    trajectories.push_back(iotest::read_text_file(out / "trajectory.csv"));
+    EXPECT_GT(trajectories.back().size(), 10000u);
+  }
+  EXPECT_EQ(trajectories[1], trajectories[0]);
+  EXPECT_EQ(trajectories[2], trajectories[0]);
+}

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "wheelins/io/text_util.hpp"
 
@@ -94,6 +95,11 @@ bool PushSession::push(int module, const ImuRow& row) {
     end_warmup();
     if (stopped_) return false;
   }
+  if (behind_) {
+    pending_.push_back(Pending{module, s, record});
+    catch_up(catch_up_per_push_);
+    return !stopped_;
+  }
   navigate(module, s, record);
   return !stopped_;
 }
@@ -105,22 +111,41 @@ void PushSession::navigate(int module, const ImuSample& s, std::uint64_t record)
   session_->check_finite(s.t);
 }
 
-// The warm-up's estimates made, the navigator built with them and the kept samples navigated.
+// The warm-up's estimates made, the navigator built with them and the kept samples navigated
+// (all, or the first slice: set_catch_up()).
 void PushSession::end_warmup() {
   calibration_ = warmup_->result();
   session_->use_calibration(calibration_);
-  for (const auto& k : warmup_->kept()) {
-    navigate(k.index, k.sample, k.record);
-    if (stopped_) break;
-  }
-  warmup_->release();
   warmup_done_ = true;
+  behind_ = true;
+  caught_up_ = 0;
+  catch_up(catch_up_per_push_ == 0 ? std::numeric_limits<std::size_t>::max() : catch_up_per_push_);
+}
+
+// Up to `n` of the samples behind navigated in order: the warm-up's kept ones, then those
+// pushed since.
+void PushSession::catch_up(std::size_t n) {
+  const auto& kept = warmup_->kept();
+  for (; n > 0 && !stopped_ && caught_up_ < kept.size() + pending_.size(); --n, ++caught_up_) {
+    if (caught_up_ < kept.size()) {
+      navigate(kept[caught_up_].index, kept[caught_up_].sample, kept[caught_up_].record);
+    } else {
+      const Pending& p = pending_[caught_up_ - kept.size()];
+      navigate(p.module, p.sample, p.record);
+    }
+  }
+  if (stopped_ || caught_up_ == kept.size() + pending_.size()) {
+    warmup_->release();
+    std::vector<Pending>().swap(pending_);
+    behind_ = false;
+  }
 }
 
 RunResult PushSession::finish() {
   if (finished_) throw InputError("finish() called twice");
   for (auto& tr : tracks_) tr.checks.finish();
   if (in_warmup()) end_warmup();  // the data ended inside the warm-up: estimates from all of it
+  if (behind_) catch_up(std::numeric_limits<std::size_t>::max());
   std::vector<SessionInput> inputs;
   for (std::size_t i = 0; i < tracks_.size(); ++i) inputs.push_back(SessionInput{tracks_[i].checks.dropped(), source_ + " of " + request().modules[i]});
   finished_ = true;

@@ -4,6 +4,7 @@
 // (run/input_checks.hpp); the rest is the RunSession every run goes through (session.hpp).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -54,6 +55,13 @@ class PushSession {
   double warmup_end() const;
   /// The warm-up's estimates are in use (CalibrationMode::kEstimate, warm-up ended).
   bool calibrated() const { return warmup_done_; }
+  /// Samples were pushed that are not navigated yet: the warm-up's kept ones (and those pushed
+  /// since) while they are navigated a slice per push (set_catch_up()).
+  bool behind() const { return behind_; }
+  /// When the warm-up ends, navigate its kept samples `per_push` at a time, with each push (a
+  /// live source's latency: no single push waits for all of them), instead of all at once (0,
+  /// the default). finish() navigates what is left.
+  void set_catch_up(std::size_t per_push) { catch_up_per_push_ = per_push; }
   const InstallationCalibration& calibration() const { return calibration_; }
 
  private:
@@ -66,12 +74,22 @@ class PushSession {
   ImuSample checked_sample(int module, const ImuRow& row, bool& admitted);
   void navigate(int module, const ImuSample& s, std::uint64_t record);
   void end_warmup();
+  void catch_up(std::size_t n);
 
   std::string source_;
   std::unique_ptr<RunSession> session_;
   std::vector<Track> tracks_;
   std::unique_ptr<CalibrationWarmup> warmup_;  ///< CalibrationMode::kEstimate
   bool warmup_done_ = false;
+  // The catch-up after the warm-up: kept samples navigated so far, samples pushed meanwhile.
+  std::size_t catch_up_per_push_ = 0, caught_up_ = 0;
+  struct Pending {
+    int module;
+    ImuSample sample;
+    std::uint64_t record;
+  };
+  std::vector<Pending> pending_;
+  bool behind_ = false;
   InstallationCalibration calibration_;
   double last_t_ = -std::numeric_limits<double>::infinity();
   double process_seconds_ = 0.0;
