@@ -17,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -453,6 +454,39 @@ std::unique_ptr<ros1::Node> connect_ros(const std::vector<std::string>& ros_args
   return std::unique_ptr<ros1::Node>(node);
 }
 
+/// Each navigated module's topic (`topics/NAME` or NAME/imu), added to the node's setup.
+std::vector<TopicState> topic_states(const LiveStream& stream, RosParams& p) {
+  std::vector<TopicState> topics;
+  for (const auto& name : stream.modules()) {
+    const auto t = p.topics.find(name);
+    topics.push_back(TopicState{t == p.topics.end() ? ros_name(name) + "/imu" : t->second, {}, 0, 0, now_seconds(), 0.0});
+    p.setup.topics.push_back(topics.back().topic);
+  }
+  for (const auto& [module, topic] : p.topics)
+    if (stream.module_index(module) < 0) throw InputError("ROS parameter topics/" + module + ": not a navigated module");
+  return topics;
+}
+
+/// A message of the topic `t`: refused (reported as a bad line) or given to the stream. False
+/// once the stream takes no more.
+bool take_message(const ros1::ImuMessage& m, TopicState& t, const RosParams& p, LiveStream& stream) {
+  ++t.received;
+  t.last_arrival = m.arrival;
+  const std::string why = refusal(m, t, p.frame_ids, stream.modules()[static_cast<std::size_t>(m.module)]);
+  if (!why.empty()) {
+    ++t.refused;
+    stream.refuse(why);
+    return true;
+  }
+  if (t.frame_id.empty()) t.frame_id = m.frame_id;
+  t.last_stamp = m.t;
+  ImuRow row;
+  row.t = m.t;
+  row.gyro = Vec3(m.gyro[0], m.gyro[1], m.gyro[2]);
+  row.accel = Vec3(m.accel[0], m.accel[1], m.accel[2]);
+  return stream.sample(m.module, row, m.arrival);
+}
+
 int live_ros(LiveArgs a, const std::vector<std::string>& ros_args) {
   const std::unique_ptr<ros1::Node> connected = connect_ros(ros_args, a.ros_wait);
   ros1::Node& node = *connected;
@@ -471,33 +505,22 @@ int live_ros(LiveArgs a, const std::vector<std::string>& ros_args) {
   opt.unit = "message";
   opt.on_state = [&](const TrajectoryRecord& r) { node.publish(odometry_message(frame(r))); };
   LiveStream stream(session, opt, stdout, stderr);
-  std::vector<TopicState> topics;
-  for (const auto& name : stream.modules()) {
-    const auto t = p.topics.find(name);
-    topics.push_back(TopicState{t == p.topics.end() ? ros_name(name) + "/imu" : t->second, {}, 0, 0, now_seconds(), 0.0});
-    p.setup.topics.push_back(topics.back().topic);
-  }
-  for (const auto& [module, topic] : p.topics)
-    if (stream.module_index(module) < 0) throw InputError("ROS parameter topics/" + module + ": not a navigated module");
+  std::vector<TopicState> topics = topic_states(stream, p);
+  // The messages are navigated on roscpp's receive thread (Node::start); this thread publishes
+  // the diagnostics and ends the run: `mutex` guards the stream, the session and the topics.
+  std::mutex mutex;
   bool more = true;
   double last_input = 0.0;
+  // Whichever way this function is left: no message after the variables the callback uses.
+  struct Unsubscribe {
+    ros1::Node& node;
+    ~Unsubscribe() { node.stop(); }
+  } const unsubscribe{node};
   node.start(p.setup, [&](const ros1::ImuMessage& m) {
-    TopicState& t = topics[static_cast<std::size_t>(m.module)];
-    ++t.received;
-    t.last_arrival = last_input = m.arrival;
-    const std::string why = refusal(m, t, p.frame_ids, stream.modules()[static_cast<std::size_t>(m.module)]);
-    if (!why.empty()) {
-      ++t.refused;
-      stream.refuse(why);
-      return;
-    }
-    if (t.frame_id.empty()) t.frame_id = m.frame_id;
-    t.last_stamp = m.t;
-    ImuRow row;
-    row.t = m.t;
-    row.gyro = Vec3(m.gyro[0], m.gyro[1], m.gyro[2]);
-    row.accel = Vec3(m.accel[0], m.accel[1], m.accel[2]);
-    if (more) more = stream.sample(m.module, row, m.arrival);
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!more) return;
+    last_input = m.arrival;
+    more = take_message(m, topics[static_cast<std::size_t>(m.module)], p, stream);
   });
   std::string mods;
   for (std::size_t i = 0; i < topics.size(); ++i) mods += (i ? ", " : "") + stream.modules()[i] + " <- " + topics[i].topic;
@@ -508,10 +531,12 @@ int live_ros(LiveArgs a, const std::vector<std::string>& ros_args) {
   const double wall0 = now_seconds(), cpu0 = cpu_seconds();
   double next_diag = wall0;
   std::vector<std::string> wrong;
-  while (more && !interrupt_requested() && node.spin(0.05)) {
+  while (!interrupt_requested() && node.spin(0.05)) {
     const double now = now_seconds();
+    if (now >= next_diag) wrong = node.wrong_types();  // asks the master: not under the lock
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!more) break;
     if (now >= next_diag) {
-      wrong = node.wrong_types();
       node.publish(diagnostics(session, stream, topics, wrong, now, p.stale_after), 0.0);
       next_diag = now + kDiagnosticsPeriod;
     }
@@ -521,6 +546,8 @@ int live_ros(LiveArgs a, const std::vector<std::string>& ros_args) {
       break;
     }
   }
+  node.stop();  // later messages are not navigated
+  const std::lock_guard<std::mutex> lock(mutex);
   const bool stopped = interrupt_requested();
   clear_interrupt();
   if (stopped) std::fprintf(stderr, "wheelins live: stopped by a signal: the run ends here\n");

@@ -1,7 +1,10 @@
 // The ROS 1 node (ros1_node.hpp), with roscpp. C++17.
 #include "ros1_node.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <exception>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -67,6 +70,20 @@ ros::Time stamp_of(double t) { return t > 0.0 ? ros::Time(t) : ros::Time(0, 0); 
 void copy_covariance(const std::array<double, 36>& from, boost::array<double, 36>& to) {
   for (std::size_t k = 0; k < 36; ++k) to[k] = from[k];
 }
+/// A callback queue that calls each callback at once, on the thread that adds it: roscpp's
+/// receive thread, right after it read a message (ros::CallbackQueueInterface, the interface
+/// roscpp's subscriptions are given their queue through). The global queue would wake the
+/// node's thread once per message: a thousand times a second with five IMUs at 200 Hz.
+class ImmediateQueue final : public ros::CallbackQueueInterface {
+ public:
+  void addCallback(const ros::CallbackInterfacePtr& callback, uint64_t /*owner_id*/) override {
+    // Each added callback is one message of one subscription; with a single caller the
+    // subscription is never busy (TryAgain) and an Invalid one is simply dropped.
+    if (callback->ready()) callback->call();
+  }
+  void removeByID(uint64_t /*owner_id*/) override {}
+};
+
 }  // namespace
 
 class RosNode final : public Node {
@@ -76,6 +93,7 @@ class RosNode final : public Node {
   std::map<std::string, std::string> private_parameters() const override;
   std::string name() const override;
   void start(const NodeSetup& setup, std::function<void(const ImuMessage&)> on_imu) override;
+  void stop() override;
   bool spin(double timeout) override;
   void publish(const Odometry& odom) override;
   void publish(const std::vector<Diagnostic>& status, double stamp) override;
@@ -88,6 +106,9 @@ class RosNode final : public Node {
     ros::Publisher odom, tf, diagnostics;
     NodeSetup setup;
     std::function<void(const ImuMessage&)> on_imu;
+    ImmediateQueue immediate;
+    std::mutex failure_mutex;
+    std::exception_ptr failure;  ///< what on_imu threw (rethrown by spin())
   };
   std::unique_ptr<Impl> impl_;
 };
@@ -112,7 +133,7 @@ RosNode::RosNode(const std::string& name, const std::vector<std::string>& ros_ar
 }
 
 RosNode::~RosNode() {
-  impl_->subs.clear();
+  stop();
   impl_->pnh.reset();
   impl_->nh.reset();
   ros::shutdown();
@@ -149,30 +170,57 @@ void RosNode::start(const NodeSetup& setup, std::function<void(const ImuMessage&
   Impl& m = *impl_;
   m.setup = setup;
   m.on_imu = std::move(on_imu);
+  // Advertised first: a message is handled (and may publish) as soon as it is subscribed to.
+  m.odom = m.nh->advertise<nav_msgs::Odometry>(setup.odom_topic, 100);
+  if (setup.publish_tf) m.tf = m.nh->advertise<tf2_msgs::TFMessage>("/tf", 100);
+  m.diagnostics = m.nh->advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
   for (std::size_t i = 0; i < setup.topics.size(); ++i) {
     const int module = static_cast<int>(i);
-    boost::function<void(const sensor_msgs::Imu::ConstPtr&)> cb = [this, module](const sensor_msgs::Imu::ConstPtr& msg) {
+    using Event = ros::MessageEvent<const sensor_msgs::Imu>;
+    boost::function<void(const Event&)> cb = [this, module](const Event& event) {
+      const sensor_msgs::Imu::ConstPtr& msg = event.getConstMessage();
       ImuMessage s;
+      // Arrival: when roscpp's transport received the message (its receipt time, on the system
+      // clock), not when this thread got to it; on simulated time the callback's time.
       s.arrival = steady_now();
+      if (ros::Time::isSystemTime()) s.arrival -= std::max(0.0, (ros::Time::now() - event.getReceiptTime()).toSec());
       s.module = module;
       s.seq = msg->header.seq;
       s.t = msg->header.stamp.toSec();
       s.frame_id = msg->header.frame_id;
       get_xyz(msg->angular_velocity, s.gyro);
       get_xyz(msg->linear_acceleration, s.accel);
-      impl_->on_imu(s);
+      Impl& impl = *impl_;
+      const std::lock_guard<std::mutex> lock(impl.failure_mutex);
+      if (impl.failure) return;
+      try {
+        impl.on_imu(s);
+      } catch (...) {
+        impl.failure = std::current_exception();
+      }
     };
-    m.subs.push_back(m.nh->subscribe<sensor_msgs::Imu>(setup.topics[i], static_cast<std::uint32_t>(setup.queue), cb,
-                                                       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+    ros::SubscribeOptions so;
+    so.initByFullCallbackType<const Event&>(setup.topics[i], static_cast<std::uint32_t>(setup.queue), cb);
+    so.transport_hints = ros::TransportHints().tcpNoDelay();
+    so.callback_queue = &m.immediate;
+    m.subs.push_back(m.nh->subscribe(so));
   }
-  m.odom = m.nh->advertise<nav_msgs::Odometry>(setup.odom_topic, 100);
-  if (setup.publish_tf) m.tf = m.nh->advertise<tf2_msgs::TFMessage>("/tf", 100);
-  m.diagnostics = m.nh->advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+}
+
+void RosNode::stop() {
+  // roscpp's subscription waits for a message being handled (its callbacks mutex) before it
+  // lets go of the callback.
+  for (auto& sub : impl_->subs) sub.shutdown();
+  impl_->subs.clear();
 }
 
 bool RosNode::spin(double timeout) {
   if (!ros::ok()) return false;
   ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(timeout));
+  {
+    const std::lock_guard<std::mutex> lock(impl_->failure_mutex);
+    if (impl_->failure) std::rethrow_exception(impl_->failure);
+  }
   return ros::ok();
 }
 

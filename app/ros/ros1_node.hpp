@@ -21,7 +21,7 @@ struct ImuMessage {
   double t = 0.0;            ///< header.stamp [s]
   double gyro[3] = {0, 0, 0}, accel[3] = {0, 0, 0};  ///< angular_velocity, linear_acceleration
   std::string frame_id;
-  double arrival = 0.0;      ///< the steady clock when the node received it [s]
+  double arrival = 0.0;      ///< the steady clock when roscpp received it (its receipt time) [s]
 };
 
 /// One nav_msgs/Odometry message (and its transform).
@@ -59,10 +59,16 @@ class Node {
   /// "name.key" entries, a list as its items joined by commas.
   virtual std::map<std::string, std::string> private_parameters() const = 0;
   virtual std::string name() const = 0;
-  /// Subscribes to the topics and advertises the odometry, /tf and /diagnostics.
+  /// Subscribes to the topics and advertises the odometry, /tf and /diagnostics. `on_imu` is
+  /// called for each message on roscpp's receive thread as soon as the message is read (no
+  /// hand-over to another thread: one wake-up per message less), so it runs concurrently with
+  /// the caller's thread; what it throws is rethrown by spin(), and no further message is given.
   virtual void start(const NodeSetup& setup, std::function<void(const ImuMessage&)> on_imu) = 0;
-  /// Handles the messages that arrived, waiting for one up to `timeout` s; false once ROS
-  /// shuts down (the master asked; Ctrl-C is the caller's).
+  /// Unsubscribes from the topics: `on_imu` is not called after it returns (a call under way
+  /// is waited for). Idempotent.
+  virtual void stop() = 0;
+  /// Waits up to `timeout` s (handling ROS's own callbacks meanwhile); false once ROS shuts down
+  /// (the master asked; Ctrl-C is the caller's). Rethrows what `on_imu` threw.
   virtual bool spin(double timeout) = 0;
   virtual void publish(const Odometry& odom) = 0;
   /// The statuses as one diagnostic_msgs/DiagnosticArray stamped `stamp` (<= 0: ROS's now).
