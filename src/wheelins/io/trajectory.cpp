@@ -502,16 +502,6 @@ TumFrame tum_frame_from_name(const std::string& name) {
 
 const char* tum_frame_name(TumFrame frame) { return frame == TumFrame::kNed ? "ned" : "enu"; }
 
-namespace {
-// ENU -> NED swaps x and y and turns z (its own inverse); body forward/right/down vectors
-// are forward/left/up ones with y and z turned (also its own inverse).
-Mat3 enu_ned_swap() {
-  Mat3 m;
-  m << 0, 1, 0, 1, 0, 0, 0, 0, -1;
-  return m;
-}
-const Mat3 kFrdFlu = Vec3(1.0, -1.0, -1.0).asDiagonal();
-}  // namespace
 
 void tum_pose_to_ned(TumFrame frame, const Vec3& xyz, const Mat3& C, Vec3& p_ned, Mat3& C_vn) {
   if (frame == TumFrame::kNed) {
@@ -521,7 +511,7 @@ void tum_pose_to_ned(TumFrame frame, const Vec3& xyz, const Mat3& C, Vec3& p_ned
   }
   const Mat3 S = enu_ned_swap();
   p_ned = S * xyz;
-  C_vn = S * C * kFrdFlu;
+  C_vn = S * C * frd_flu_swap();
 }
 
 void tum_pose_from_ned(TumFrame frame, const Vec3& p_ned, const Mat3& C_vn, Vec3& xyz, Mat3& C) {

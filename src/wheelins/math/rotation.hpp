@@ -51,6 +51,13 @@ Quat quat_from_rotvec(const Vec3& rv);
 Vec3 rotvec_from_quat(const Quat& q);
 
 /// Elementary rotations of a frame about its own axis (C_b^a for b rotated by angle about a's axis).
+/// North-east-down <-> east-north-up (REP 103's world frame): x and y swapped, z turned; its
+/// own inverse.
+inline Mat3 enu_ned_swap() { return (Mat3() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished(); }
+/// Body forward-right-down <-> forward-left-up (REP 103's base_link): y and z turned; its own
+/// inverse.
+inline Mat3 frd_flu_swap() { return Vec3(1.0, -1.0, -1.0).asDiagonal(); }
+
 Mat3 rot_x(double angle);
 Mat3 rot_y(double angle);
 Mat3 rot_z(double angle);

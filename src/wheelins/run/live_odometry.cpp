@@ -8,9 +8,6 @@
 namespace wheelins {
 
 namespace {
-// NED -> ENU for a vector (its own inverse).
-Vec3 enu_of_ned(const Vec3& v) { return Vec3(v.y(), v.x(), -v.z()); }
-
 void put_block(std::array<double, 36>& cov, int at, const Mat3& block) {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) cov[static_cast<std::size_t>((at + r) * 6 + at + c)] = block(r, c);
@@ -34,8 +31,10 @@ OdometryState OdometryFrame::operator()(const TrajectoryRecord& r) {
   const Mat3 p_cov_enu = Vec3(r.p_std.y() * r.p_std.y(), r.p_std.x() * r.p_std.x(), r.p_std.z() * r.p_std.z()).asDiagonal();
   put_block(s.pose_covariance, 0, odom_from_enu_ * p_cov_enu * odom_from_enu_.transpose());
   put_block(s.pose_covariance, 3, Mat3(r.rpy_std.cwiseProduct(r.rpy_std).asDiagonal()));
-  s.linear = C.transpose() * enu_of_ned(r.v_inN);
-  const Mat3 v_cov_enu = enu_of_ned(r.v_std).cwiseProduct(enu_of_ned(r.v_std)).asDiagonal();
+  const Mat3 enu_from_ned = enu_ned_swap();
+  s.linear = C.transpose() * enu_from_ned * r.v_inN;
+  const Vec3 v_std_enu = enu_from_ned * r.v_std;  // east, north, up (a sign drops out squared)
+  const Mat3 v_cov_enu = v_std_enu.cwiseProduct(v_std_enu).asDiagonal();
   put_block(s.twist_covariance, 0, C.transpose() * v_cov_enu * C);
   const double dt = r.t - last_t_;
   if (started_ && dt > 0.0) {

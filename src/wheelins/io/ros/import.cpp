@@ -33,9 +33,9 @@ std::string module_name_for_topic(const std::string& topic) {
 namespace {
 
 // Frame conventions: ENU world / FLU body (REP 103) to the NED / FRD frames of the truth
-// file. T maps ENU vectors to NED (swap x, y; negate z), D maps FRD vectors to FLU.
-const Mat3 kEnuToNed = (Mat3() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
-const Mat3 kFrdToFlu = Vec3(1, -1, -1).asDiagonal();
+// file (math/rotation.hpp: both maps are their own inverses).
+const Mat3 kEnuToNed = enu_ned_swap();
+const Mat3 kFrdToFlu = frd_flu_swap();
 
 struct Track {
   std::string topic, kind_text;
