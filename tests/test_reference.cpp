@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -854,6 +855,43 @@ TEST_F(RealCar, CalibratedVehicleOnTheOtherTrialBeatsTheOdometryBaseline) {
     EXPECT_LT(final_error, baseline) << r.out;
     EXPECT_GT(number_after(r.out, "distance"), 400.0) << r.out;
   }
+}
+
+TEST_F(RealCar, BodyImuRollAndPitchFromTheDriveAgreeAcrossTrialsAndAnAtRestOneIsWarnedAbout) {
+  // The Body-IMU stayed where it was between the trials; the cars stood on ground tilted
+  // differently (its up axis at rest: [175, 0.1] on trial02, [171.85, 2.21] on trial04).
+  // The drafted roll and pitch come from the drive: the two trials agree.
+  const fs::path own = dir() / "trial04-own";
+  fs::remove_all(own);
+  const CmdResult a = wheelins_cli("import " + q(data() / "trial04") + " --preset xsens-dot --out " + q(own), dir());
+  ASSERT_EQ(a.code, 0) << a.out << a.err;
+  EXPECT_HAS(a.out, "where the vehicle stood still its up axis was");
+  const Manifest m2 = load_manifest(dir() / "trial02" / "manifest.yaml", {});
+  const Manifest m4 = load_manifest(own / "manifest.yaml", {});
+  const ModuleSpec* b2 = m2.find("CAR");
+  const ModuleSpec* b4 = m4.find("CAR");
+  ASSERT_TRUE(b2 && b4);
+  const Vec3 down2 = dcm_from_euler(b2->mounting_rpy).transpose() * Vec3::UnitZ();
+  const Vec3 down4 = dcm_from_euler(b4->mounting_rpy).transpose() * Vec3::UnitZ();
+  EXPECT_LT(std::acos(std::clamp(down2.dot(down4), -1.0, 1.0)) / kDeg, 1.0)
+      << (b2->mounting_rpy / kDeg).transpose() << " vs " << (b4->mounting_rpy / kDeg).transpose();
+  // trial04's up axis at rest as its mounting: a run warns and names the key.
+  std::string text = iotest::read_text_file(manifest());
+  const std::size_t entry = text.find("name: \"CAR\"");
+  ASSERT_NE(entry, std::string::npos);
+  const std::size_t at = text.find("    mounting_deg:", entry);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, text.find('\n', at) - at, "    mounting_deg: [171.85, 2.21, 97.82]");
+  const fs::path file = dir() / "trial04" / "at-rest.yaml";
+  iotest::write_text(file, text);
+  const CmdResult r = wheelins_cli("run -q -m " + q(file) + " -c body-wheel --formats csv -o " + q(dir() / "at-rest"), dir());
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_HAS(r.err, "module 'CAR': over the drive the vehicle's down axis is");
+  EXPECT_HAS(r.err, "set modules[0].mounting_deg to about [175");
+  // The manifest as drafted: no such warning.
+  const CmdResult ok = wheelins_cli("run -q -m " + q(manifest()) + " -c body-wheel --formats csv -o " + q(dir() / "as-drafted"), dir());
+  ASSERT_EQ(ok.code, 0) << ok.out << ok.err;
+  EXPECT_EQ(ok.err.find("over the drive"), std::string::npos) << ok.err;
 }
 
 TEST_F(RealCar, ManifestTrapsAreErrorsNamingTheModule) {

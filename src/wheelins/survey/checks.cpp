@@ -6,6 +6,8 @@
 #include <cstdio>
 
 #include "wheelins/io/text_util.hpp"
+#include "wheelins/survey/format.hpp"
+#include "wheelins/survey/level.hpp"
 
 namespace wheelins::survey {
 namespace {
@@ -14,25 +16,11 @@ using io_detail::format_double;
 
 /// printf of up to three numbers, as long as it takes (the steering warning alone is over
 /// 200 characters).
-std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
-  const int n = std::snprintf(nullptr, 0, f, a, b, c);
-  if (n <= 0) return {};
-  std::string out(static_cast<std::size_t>(n) + 1, '\0');
-  std::snprintf(out.data(), out.size(), f, a, b, c);
-  out.resize(static_cast<std::size_t>(n));
-  return out;
-}
-
 std::string axis_name(const Vec3& u) {
   int k = 0;
   u.cwiseAbs().maxCoeff(&k);
   if (std::abs(u[k]) > 0.97) return std::string(u[k] > 0 ? "+" : "-") + "xyz"[k];
   return fmt("[%.2f, %.2f, %.2f]", u.x(), u.y(), u.z());
-}
-
-double angle_deg(const Vec3& a, const Vec3& b) {
-  const double c = std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0);
-  return std::acos(c) / kDeg;
 }
 
 }  // namespace
@@ -225,6 +213,18 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
                 who + ": the vehicle's forward axis is along its sensor's " + axis_name(f->forward) +
                     fmt(" axis (from its accelerations, fit %.2f), ", f->forward_fit) + fmt("%.0f deg from the manifest's (", off) +
                     axis_name(fwd_inS) + "): set " + key + fmt("mounting_deg to about [%.0f, %.0f, %.0f]", rpy.x(), rpy.y(), rpy.z()));
+          continue;
+        }
+      }
+      if (f->axes_found && f->level.found) {
+        const double off = angle_deg(down_inS, -f->level.up);
+        const double sigma = std::hypot(f->level.sigma_roll_deg, f->level.sigma_pitch_deg);
+        if (off > std::max(o.body_level_tolerance_deg, 3.0 * sigma)) {
+          const Vec3 rpy = euler_from_dcm(vehicle_axes(f->level.up, C_BtoV.transpose() * Vec3::UnitX())) / kDeg;
+          warning(spec->name, key + "mounting_deg",
+                  who + fmt(": over the drive the vehicle's down axis is %.1f deg from the manifest's mounting_deg (level fit, +- %.1f deg; ", off, sigma) +
+                      "a mounting taken where the vehicle stood on a slope holds the slope): set " + key +
+                      fmt("mounting_deg to about [%.1f, %.1f, %.1f]", rpy.x(), rpy.y(), rpy.z()));
         }
       }
     }

@@ -33,6 +33,9 @@ struct DataCheckOptions {
   double min_coverage = 0.8;          ///< share of the run a module's data must cover
   double body_axis_tolerance_deg = 25.0;   ///< a Body-IMU's down axis vs gravity
   double body_forward_tolerance_deg = 45.0;
+  /// A Body-IMU's down axis vs the drive's level fit (survey/level.hpp): a warning beyond
+  /// this and three of the fit's sigmas.
+  double body_level_tolerance_deg = 1.5;
   double min_motion = 10.0;           ///< [s] of motion before a kind is judged
 };
 

@@ -1,6 +1,7 @@
 // The survey of a set of modules (dataset.hpp): kinds, axes, clocks, sides, steering and
 // the static period, from the data alone.
 #include "wheelins/survey/dataset.hpp"
+#include "wheelins/survey/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,12 +9,6 @@
 
 namespace wheelins::survey {
 namespace {
-
-std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
 
 Signal shifted(Signal s, double offset) {
   s.shift(offset);
@@ -486,6 +481,7 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
       f.forward = fwd;
       f.left = lft;
       f.axes_found = f.forward_fit > 0.5;
+      if (f.axes_found) f.level = fit_level(S[i], f.traits.up, f.forward, o.level);
     }
   }
 
@@ -504,6 +500,11 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
       out.notes.push_back(f.module + fmt(": forward axis [%.2f, %.2f, %.2f] in its axes", f.forward.x(), f.forward.y(), f.forward.z()) +
                           fmt(" (acceleration fit %.2f, centripetal fit %.2f), up ", f.forward_fit, f.left_fit) +
                           fmt("[%.2f, %.2f, %.2f]", t.up.x(), t.up.y(), t.up.z()));
+    if (f.kind == ModuleKind::kBody && f.axes_found)
+      out.notes.push_back(f.module + (f.level.found ? fmt(": level from the drive: up [%.3f, %.3f, %.3f]", f.level.up.x(), f.level.up.y(), f.level.up.z()) +
+                                                          fmt(" (+- %.1f deg roll, +- %.1f deg pitch; ", f.level.sigma_roll_deg, f.level.sigma_pitch_deg) +
+                                                          fmt("%.1f deg from the up-axis at rest: the ground it stood on)", angle_deg(f.level.up, t.up))
+                                                    : ": level not fitted from the drive: " + f.level.why));
     if (!f.clock_reference && f.clock.found)
       out.notes.push_back(f.module + fmt(": clock offset %+.4f s +- %.4f s (correlation %.3f, ", f.clock.offset, f.clock.sigma, f.clock.correlation) +
                           f.clock_basis + ")");

@@ -17,6 +17,8 @@
 //    than an unsteered wheel's does (needs a Body-IMU for the vehicle's yaw rate);
 //  * a body's axes: its specific force follows the wheels' acceleration along the vehicle's
 //    forward axis and speed times yaw rate along its left axis (the centripetal acceleration);
+//    its roll and pitch on the vehicle from the drive: the vertical specific force does not
+//    follow the horizontal (survey/level.hpp; the up-axis at rest holds the ground's tilt);
 //  * the static period: the first interval in which every module rests, on the common
 //    clock: every wheel's spin rate at its bias, and every body's rate and specific force
 //    as quiet as they get (an idling engine's shaking can keep a body from ever being
@@ -31,6 +33,7 @@
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/nav/vehicle.hpp"
 #include "wheelins/survey/clock.hpp"
+#include "wheelins/survey/level.hpp"
 #include "wheelins/survey/traits.hpp"
 
 namespace wheelins::survey {
@@ -46,6 +49,7 @@ struct SurveyOptions {
   SeriesOptions series;
   TraitOptions traits;
   ClockOptions clock;
+  LevelFitOptions level;
   double min_static = 2.0;       ///< [s] shortest static period drafted
   double static_margin = 0.3;    ///< [s] taken off both ends of the common rest
   /// Wheels known to steer (a manifest's steered: true): their yaw rate leads the vehicle's,
@@ -88,6 +92,9 @@ struct ModuleFinding {
   bool axes_found = false;
   Vec3 forward = Vec3::UnitX(), left = Vec3::UnitY();
   double forward_fit = 0.0, left_fit = 0.0;  ///< correlation of each fit
+  /// Bodies with their axes found: the vehicle's up axis from the drive (survey/level.hpp),
+  /// free of the ground's tilt where the vehicle stood (which `traits.up` holds).
+  LevelFit level;
 };
 
 struct DatasetSurvey {

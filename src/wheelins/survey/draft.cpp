@@ -8,6 +8,8 @@
 
 #include "wheelins/nav/types.hpp"
 #include "wheelins/survey/checks.hpp"
+#include "wheelins/survey/format.hpp"
+#include "wheelins/survey/level.hpp"
 
 namespace wheelins::survey {
 namespace {
@@ -18,12 +20,6 @@ double round_to(double x, double q) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", std::max(0, static_cast<int>(std::lround(-std::log10(q)))), std::round(x / q) * q);
   return std::strtod(buf, nullptr);
-}
-
-std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
 }
 
 /// The vehicle keys of a calibrated manifest's module, onto a drafted one.
@@ -150,20 +146,19 @@ ManifestDraft draft_from_survey(const DatasetSurvey& survey, const std::vector<D
     } else {
       s.lever_arm_inB = Vec3::Zero();
       s.p_inV = vt.body_position;
-      // C_b^v from the measured axes: rows forward, right, down in sensor axes.
-      Mat3 C;
-      const Vec3 down = -f->traits.up;
-      const Vec3 fwd = f->axes_found ? f->forward : Vec3::UnitX();
-      const Vec3 fw = (fwd - fwd.dot(down) * down).normalized();
-      const Vec3 right = down.cross(fw);
-      C.row(0) = fw.transpose();
-      C.row(1) = right.transpose();
-      C.row(2) = down.transpose();
-      s.mounting_rpy = euler_from_dcm(C);
+      // C_b^v from the measured axes: rows forward, right, down in sensor axes; the up axis
+      // from the drive where it could be fitted, else where the vehicle stood still (which
+      // holds the ground's tilt there).
+      const bool level = f->axes_found && f->level.found;
+      s.mounting_rpy = euler_from_dcm(vehicle_axes(level ? f->level.up : f->traits.up, f->axes_found ? f->forward : Vec3::UnitX()));
       for (int k = 0; k < 3; ++k) s.mounting_rpy[k] = round_to(s.mounting_rpy[k] / kDeg, 0.01) * kDeg;
-      note[key + "mounting_deg"] = f->axes_found
-                                       ? fmt("from the data: up-axis at rest, forward axis from accelerations (fit %.2f); refined by every run", f->forward_fit)
-                                       : "roll, pitch from the data; yaw TODO (no clear forward acceleration)";
+      note[key + "mounting_deg"] = !f->axes_found ? "roll, pitch from the data; yaw TODO (no clear forward acceleration)"
+                                   : level ? fmt("from the data: roll, pitch from the drive (level fit, +- %.1f / %.1f deg), ", f->level.sigma_roll_deg, f->level.sigma_pitch_deg) +
+                                                 fmt("forward axis from accelerations (fit %.2f); refined by every run", f->forward_fit)
+                                           : fmt("from the data: up-axis at rest, forward axis from accelerations (fit %.2f); refined by every run", f->forward_fit);
+      if (level && angle_deg(f->level.up, f->traits.up) > 1.0)
+        d.facts.push_back(in.name + fmt(": where the vehicle stood still its up axis was %.1f deg from the drive's (the ground's tilt there, ", angle_deg(f->level.up, f->traits.up)) +
+                          fmt("or the fit's error: +- %.1f / %.1f deg); the drive's taken for its roll and pitch", f->level.sigma_roll_deg, f->level.sigma_pitch_deg));
       if (!f->axes_found) d.todo.push_back(in.name + ": mounting_deg yaw (the data showed no clear forward axis)");
       if (prior) {
         carry_over(*prior, s);
