@@ -14,8 +14,6 @@ namespace {
 
 using io_detail::format_double;
 
-/// printf of up to three numbers, as long as it takes (the steering warning alone is over
-/// 200 characters).
 std::string axis_name(const Vec3& u) {
   int k = 0;
   u.cwiseAbs().maxCoeff(&k);

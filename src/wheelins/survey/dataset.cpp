@@ -503,7 +503,7 @@ DatasetSurvey survey_series(const std::vector<Series>& S, const SurveyOptions& o
     if (f.kind == ModuleKind::kBody && f.axes_found)
       out.notes.push_back(f.module + (f.level.found ? fmt(": level from the drive: up [%.3f, %.3f, %.3f]", f.level.up.x(), f.level.up.y(), f.level.up.z()) +
                                                           fmt(" (+- %.1f deg roll, +- %.1f deg pitch; ", f.level.sigma_roll_deg, f.level.sigma_pitch_deg) +
-                                                          fmt("%.1f deg from the up-axis at rest: the ground it stood on)", angle_deg(f.level.up, t.up))
+                                                          fmt("the up-axis at rest is %.1f deg from it)", angle_deg(f.level.up, t.up))
                                                     : ": level not fitted from the drive: " + f.level.why));
     if (!f.clock_reference && f.clock.found)
       out.notes.push_back(f.module + fmt(": clock offset %+.4f s +- %.4f s (correlation %.3f, ", f.clock.offset, f.clock.sigma, f.clock.correlation) +

@@ -13,6 +13,8 @@
 // by the slopes until they vanish. The slopes' standard errors are the fit's uncertainty.
 #pragma once
 
+#include <string>
+
 #include "wheelins/nav/types.hpp"
 #include "wheelins/survey/series.hpp"
 
