@@ -200,13 +200,9 @@ std::vector<DataCheck> check_against_data(const Manifest& man, const std::vector
         const Vec3 fwd_inS = C_BtoV.transpose() * Vec3::UnitX();
         const double off = angle_deg(fwd_inS, f->forward);
         if (off > o.body_forward_tolerance_deg) {
-          const Vec3 down = -f->traits.up;
-          const Vec3 fw = (f->forward - f->forward.dot(down) * down).normalized();
-          Mat3 C;
-          C.row(0) = fw.transpose();
-          C.row(1) = down.cross(fw).transpose();
-          C.row(2) = down.transpose();
-          const Vec3 rpy = euler_from_dcm(C) / kDeg;
+          // The angles to set, as the import drafts them (the up axis from the drive if fitted).
+          const Vec3 up = f->level.found ? f->level.up : f->traits.up;
+          const Vec3 rpy = euler_from_dcm(vehicle_axes(up, f->forward)) / kDeg;
           error(spec->name, key + "mounting_deg",
                 who + ": the vehicle's forward axis is along its sensor's " + axis_name(f->forward) +
                     fmt(" axis (from its accelerations, fit %.2f), ", f->forward_fit) + fmt("%.0f deg from the manifest's (", off) +
