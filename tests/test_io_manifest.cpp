@@ -378,6 +378,26 @@ TEST(IoManifest, SteeredWheelRoundTripsAndIsChecked) {
              "modules[0].position_v_m: a steered wheel's x is its distance ahead of the rear axle");
 }
 
+TEST(IoManifest, YawScaleRoundTripsAndIsChecked) {
+  ScratchDir dir;
+  const auto mod = [&](const std::string& extra) {
+    return with_modules("modules:\n  - {name: a, file: a.bin" + extra + "}\n");
+  };
+  write_text(dir / "m.yaml", mod(", kind: wheel, wheel_radius_m: 0.3, yaw_scale_ppm: -4200.5"));
+  const Manifest m = load_manifest(dir / "m.yaml", kQuiet);
+  EXPECT_DOUBLE_EQ(m.modules[0].yaw_scale, -4200.5e-6);
+  save_manifest(m, dir / "m2.yaml");
+  EXPECT_DOUBLE_EQ(load_manifest(dir / "m2.yaml", kQuiet).modules[0].yaw_scale, -4200.5e-6);
+  // Left out when zero.
+  write_text(dir / "m3.yaml", mod(", kind: wheel, wheel_radius_m: 0.3"));
+  save_manifest(load_manifest(dir / "m3.yaml", kQuiet), dir / "m4.yaml");
+  EXPECT_EQ(read_text_file(dir / "m4.yaml").find("yaw_scale_ppm"), std::string::npos);
+  EXPECT_HAS(load_error(dir, mod(", kind: body, yaw_scale_ppm: 100")),
+             "modules[0].yaw_scale_ppm: only a wheel module has a yaw scale factor");
+  EXPECT_HAS(load_error(dir, mod(", kind: wheel, wheel_radius_m: 0.3, yaw_scale_ppm: 60000")), "modules[0].yaw_scale_ppm");
+  EXPECT_HAS(load_error(dir, mod(", kind: wheel, wheel_radius_m: 0.3, yaw_scale_ppm: much")), "modules[0].yaw_scale_ppm");
+}
+
 TEST(IoManifest, PhysicallyImpossibleValues) {
   ScratchDir dir;
   const auto mod = [&](const std::string& extra) {

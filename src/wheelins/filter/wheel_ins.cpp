@@ -12,6 +12,7 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
     : Subsystem(module, mech),
       opt_(opt),
       C_StoB_(wheel_sensor_to_body(module)),
+      G_StoB_(Vec3(1.0, 1.0 / (1.0 + module.yaw_scale), 1.0 / (1.0 + module.yaw_scale)).asDiagonal() * C_StoB_),
       axle_sign_(module.axle_sign) {
   // A steered wheel's speed and geometry change with the steering over a turn: no whole-turn
   // averages for it.
@@ -40,7 +41,7 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
 
 ImuSample WheelIns::to_body(const ImuSample& s) const {
   ImuSample b = s;
-  b.dtheta = C_StoB_ * s.dtheta;
+  b.dtheta = G_StoB_ * s.dtheta;
   b.dvel = C_StoB_ * s.dvel;
   return b;
 }

@@ -130,6 +130,8 @@ class WheelIns final : public Subsystem {
   double compensated_omega_x(double raw) const;
   WheelInsOptions opt_;
   Mat3 C_StoB_;
+  /// The gyro's: C_StoB_ with the wheel-plane axes divided by (1 + yaw_scale).
+  Mat3 G_StoB_;
   int axle_sign_;
   double vehicle_roll_ = 0.0, vehicle_pitch_ = 0.0;
   std::array<double, kMaxWindow> window_{};

@@ -114,7 +114,7 @@ const std::vector<std::string> kVehicleKeys = {"track_m", "wheelbase_m", "antenn
 const std::vector<std::string> kModuleKeys = {
     "name",          "kind",          "group",        "chip",      "file",
     "format",        "layout",        "rate_hz",      "time_offset_s", "position_v_m",
-    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "axle_axis",  "wheel_radius_m", "odometry_radius_m", "steered", "gyro_range_dps",
+    "lever_arm_b_m", "mounting_deg",  "axle_sign",    "axle_axis",  "wheel_radius_m", "odometry_radius_m", "yaw_scale_ppm", "steered", "gyro_range_dps",
     "accel_range_m_s2", "noise"};
 
 /// One noise key: its name, its unit factor and the ImuNoise member it fills.
@@ -386,6 +386,14 @@ ModuleSpec Loader::module(const YAML::Node& n, const std::string& path) const {
     s.odometry_radius = number(v, join(path, "odometry_radius_m"));
     range(s.odometry_radius, 0.01, 2.0, join(path, "odometry_radius_m"), v, "m (a wheel radius)");
   }
+  if (auto v = get(n, "yaw_scale_ppm"); v.IsDefined()) {
+    const std::string p = join(path, "yaw_scale_ppm");
+    if (s.kind != ModuleKind::kWheel)
+      fail(p, "only a wheel module has a yaw scale factor here (a body module's gyro is not scaled)", &v);
+    range(number(v, p), -ManifestLimits::kYawScalePpm, ManifestLimits::kYawScalePpm, p, v,
+          "ppm (the wheel-plane gyro axes' scale-factor error)");
+    s.yaw_scale = number(v, p) * 1e-6;
+  }
   if (auto v = get(n, "gyro_range_dps"); v.IsDefined()) {
     const std::string p = join(path, "gyro_range_dps");
     range(number(v, p), ManifestLimits::kGyroRangeMinDps, ManifestLimits::kGyroRangeMaxDps, p, v,
@@ -588,6 +596,9 @@ std::string manifest_to_yaml(const Manifest& m, const fs::path& dir, const Manif
     if (s.odometry_radius > 0.0)
       w.line(4, "odometry_radius_m: " + num(s.odometry_radius), p + "odometry_radius_m",
              "for the raw axle rate (wheelins odometry)");
+    if (s.yaw_scale != 0.0)
+      w.line(4, "yaw_scale_ppm: " + num(s.yaw_scale * 1e6), p + "yaw_scale_ppm",
+             "the wheel-plane gyro axes read (1 + this) x the rate (from a reference)");
     if (s.gyro_range > 0.0)
       w.line(4, "gyro_range_dps: " + num(s.gyro_range, kDegU), p + "gyro_range_dps",
              "full scale: readings at it are saturated");

@@ -33,6 +33,7 @@ struct ManifestLimits {
   static constexpr double kGyroRangeMaxDps = 1e5;
   static constexpr double kAccelRangeMin = 5.0;     ///< accel_range_m_s2 [m/s^2]
   static constexpr double kAccelRangeMax = 1e5;
+  static constexpr double kYawScalePpm = 50000.0;   ///< |yaw_scale_ppm| (5 %)
 };
 
 /// One IMU module (one chip's data file): the module as the estimator knows it (name, kind,

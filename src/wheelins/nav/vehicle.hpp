@@ -56,6 +56,12 @@ struct ImuModule {
   /// v-frame origin o is then the mid rear (unsteered) axle: p_inV.x is the wheel's distance
   /// ahead of it.
   bool steered = false;
+  /// Wheel-IMU: the scale-factor error of its gyro about the vehicle's vertical, s: the two
+  /// gyro axes in the wheel plane read (1 + s) times the rate about them (their mean scale
+  /// factor: as the wheel rolls the yaw rate turns through both), so their readings are
+  /// divided by (1 + s). The wheel's rotation cancels a bias, not a scale factor, and
+  /// nothing but a heading reference shows it (`wheelins calibrate --reference`). [-]
+  double yaw_scale = 0.0;
   /// Gyro full scale [rad/s] (readings at it are saturated); 0 = not stated.
   double gyro_range = 0.0;
   /// Accelerometer full scale [m/s^2]; 0 = not stated. A reading beyond either range (+5 %)

@@ -143,14 +143,7 @@ SpeedScale fit_speed_scale(const RefSpeed& ref_speed, const Signal& x_sig, const
 /// The horizontal speed a single Wheel-INS of `module` gives (its own Wheel-INS, the
 /// manifest's geometry as it is, no data checks) [m/s] at its records.
 Signal wheel_ins_speed(const Manifest& m, const std::string& module) {
-  RunRequest req;
-  req.manifest = m;
-  req.modules = {module};
-  req.calibration = CalibrationMode::kManifest;
-  req.data_checks = false;
-  req.progress = false;
-  req.nav.output_interval = 0.02;
-  req.warn = [](const std::string&) {};
+  RunRequest req = calibration_run_request(m, {module}, 0.02);
   Signal s;
   req.on_record = [&](const TrajectoryRecord& r) {
     s.t.push_back(r.t);
@@ -432,6 +425,8 @@ WheelRadiusFit fit_wheel_radius(const Drive& drive, std::size_t i, std::vector<s
   WheelRadiusFit w;
   w.module = spec.name;
   w.manifest_radius = drive.m0.find(spec.name)->wheel_radius;
+  w.manifest_yaw_scale = drive.m0.find(spec.name)->yaw_scale;
+  w.yaw.yaw_scale = CalibratedValue{spec.yaw_scale, 0.0, false};
   w.radius = CalibratedValue{spec.wheel_radius, 0.0, false};
   const Signal omega = axle_rate(drive, i);
   const SpeedScale first = fit_speed_scale(ref_speed, omega, drive.yaw, m.static_end, o.min_speed);
@@ -566,6 +561,26 @@ void align_dead_reckoning(const Drive& drive, ReferenceCalibration& out) {
     align_onto_reference(drive, dead_reckon(dr, out.navigation_modules, drive.o.progress), out);
 }
 
+/// Each wheel's yaw scale factor: its own Wheel-INS with the radii, the clock and the antenna
+/// found above, against the reference's course (yaw_scale_fit.hpp); one note naming those not
+/// observed.
+void fit_yaw_scales(const Drive& drive, ReferenceCalibration& out) {
+  const Manifest cal = apply_reference_calibration(drive.m, out);
+  std::string unobserved;
+  double turned = 0.0;
+  for (WheelRadiusFit& w : out.wheels) {
+    w.yaw = fit_yaw_scale(cal, w.module, drive.o.yaw_scale);
+    if (w.yaw.yaw_scale.observed) continue;
+    unobserved += (unobserved.empty() ? "" : ", ") + w.module;
+    turned = std::max(turned, w.yaw.turn_span);
+  }
+  if (!unobserved.empty())
+    out.notes.push_back("the yaw scale factor of " + unobserved +
+                        fmt(" is not told from the manifest's by this drive (%.0f deg of heading turned; the "
+                            "estimates above): the manifest's kept",
+                            turned / kDeg));
+}
+
 }  // namespace
 
 ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::vector<std::string>& modules,
@@ -592,6 +607,7 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m0, const std::
     if (m.find(modules[i])->kind == ModuleKind::kWheel) out.wheels.push_back(fit_wheel_radius(drive, i, out.notes));
 
   align_dead_reckoning(drive, out);
+  if (o.estimate_yaw_scale) fit_yaw_scales(drive, out);
   if (warn)
     for (const auto& n : out.notes) warn(quote(m.path) + ": " + n);
   return out;
@@ -603,6 +619,10 @@ Manifest apply_reference_calibration(Manifest m, const ReferenceCalibration& cal
     if (w.radius.observed)
       for (auto& s : m.modules)
         if (s.name == w.module) s.wheel_radius = w.radius.value;
+  for (const WheelRadiusFit& w : cal.wheels)
+    if (w.yaw.yaw_scale.observed)
+      for (auto& s : m.modules)
+        if (s.name == w.module) s.yaw_scale = w.yaw.yaw_scale.value;
   for (const WheelRadiusFit& w : cal.wheels)
     if (w.odometry_radius.observed)
       for (auto& s : m.modules)
@@ -628,6 +648,14 @@ std::string reference_calibration_report(const ReferenceCalibration& c) {
          (w.radius.observed ? fmt("  %.0f epochs, correlation %.4f; raw axle rate %.4f m\n", static_cast<double>(w.epochs),
                                   w.correlation, w.odometry_radius.value)
                             : std::string("  not observed: manifest kept\n"));
+  for (const WheelRadiusFit& w : c.wheels)
+    if (w.yaw.epochs > 0)
+      s += "  " + w.module + std::string(std::max<int>(1, 12 - static_cast<int>(w.module.size())), ' ') +
+           fmt("yaw scale %+.0f +- %.0f ppm (%+.0f)", w.yaw.yaw_scale.value * 1e6, w.yaw.yaw_scale.std * 1e6,
+               w.manifest_yaw_scale * 1e6) +
+           (w.yaw.yaw_scale.observed ? fmt("  over %.0f deg turned, heading residual %.2f deg\n", w.yaw.turn_span / kDeg,
+                                           w.yaw.residual / kDeg)
+                                     : std::string("  not observed: manifest kept\n"));
   const auto& a = c.alignment;
   s += fmt("  initial heading  %.3f +- %.3f deg", c.initial_heading.value / kDeg, c.initial_heading.std / kDeg) +
        (c.initial_heading.observed ? fmt("  (dead reckoning of %.0f wheel(s) aligned over %.0f m, residual %.3f m)\n",
@@ -650,7 +678,8 @@ std::string reference_calibration_yaml(const ReferenceCalibration& c, const Mani
   std::string s = "reference:\n  wheels:\n";
   for (const WheelRadiusFit& w : c.wheels)
     s += "    " + io_detail::json_quote(w.module) + ":\n      wheel_radius_m: " + val(w.radius, 1.0, w.manifest_radius) +
-         "\n      odometry_radius_m: " + val(w.odometry_radius, 1.0, w.manifest_radius) + "\n";
+         "\n      odometry_radius_m: " + val(w.odometry_radius, 1.0, w.manifest_radius) +
+         "\n      yaw_scale_ppm: " + val(w.yaw.yaw_scale, 1e6, w.manifest_yaw_scale) + "\n";
   s += "  truth_time_offset_s: " + val(c.truth_time_offset, 1.0, m.truth_time_offset) + "\n";
   s += "  initial:\n    heading_deg: " + val(c.initial_heading, 1.0 / kDeg, m.initial_heading) + "\n";
   s += "  vehicle:\n    antenna_forward_m: " + val(c.antenna_forward, 1.0, m.antenna_inV ? m.antenna_inV->x() : 0.0) + "\n";

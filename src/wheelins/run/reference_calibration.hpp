@@ -12,7 +12,10 @@
 //   * the initial heading and the antenna's horizontal position on the vehicle: a dead
 //     reckoning of the unsteered wheels with the radii, in a local frame, aligned onto the
 //     reference over its first `align_length` metres (eval/alignment.hpp);
-// Vehicle values (radii, antenna) carry over to its other recordings; the initial heading
+//   * each wheel's yaw scale factor (the scale of its gyro axes in the wheel plane): its own
+//     Wheel-INS with the radii, the clock and the antenna above, its heading error against
+//     the reference's course regressed on the heading turned (run/yaw_scale_fit.hpp);
+// Vehicle values (radii, yaw scales, antenna) carry over to its other recordings; the initial heading
 // belongs to this recording only.
 #pragma once
 
@@ -23,6 +26,7 @@
 #include "wheelins/io/diagnostics.hpp"
 #include "wheelins/io/manifest.hpp"
 #include "wheelins/run/calibration.hpp"
+#include "wheelins/run/yaw_scale_fit.hpp"
 
 namespace wheelins {
 
@@ -30,6 +34,8 @@ struct ReferenceCalibrationOptions {
   double min_speed = 1.5;        ///< [m/s] reference speed of the epochs the radius uses
   double align_length = 300.0;   ///< [m] of the reference's travel the heading fit uses (<= 0: all)
   bool estimate_antenna = true;
+  bool estimate_yaw_scale = true;   ///< each wheel's yaw scale factor (yaw_scale_fit.hpp)
+  YawScaleFitOptions yaw_scale;
   double max_antenna_sigma = 0.15;  ///< [m] the antenna is taken as observed below this 1 sigma
   bool progress = false;
 };
@@ -39,6 +45,8 @@ struct WheelRadiusFit {
   CalibratedValue radius;     ///< [m] for the filter (its own speed against the reference)
   CalibratedValue odometry_radius;  ///< [m] for the raw axle rate (a plain odometer)
   double manifest_radius = 0.0;
+  YawScaleFit yaw;                  ///< its yaw scale factor (yaw_scale_fit.hpp)
+  double manifest_yaw_scale = 0.0;
   double correlation = 0.0;   ///< of the reference's speed and the fit
   std::size_t epochs = 0;
 };
@@ -60,7 +68,7 @@ ReferenceCalibration calibrate_against_reference(const Manifest& m, const std::v
                                                  const InstallationCalibration& installation,
                                                  const ReferenceCalibrationOptions& options, const WarningSink& warn);
 
-/// The manifest with the radii, the initial heading and the antenna applied (what is not
+/// The manifest with the radii, the yaw scales, the initial heading and the antenna applied (what is not
 /// observed keeps the manifest's value).
 Manifest apply_reference_calibration(Manifest m, const ReferenceCalibration& cal);
 

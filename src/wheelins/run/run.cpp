@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <set>
+#include <utility>
 
 #include "wheelins/io/imu_file.hpp"
 #include "wheelins/io/text_util.hpp"
@@ -138,6 +139,18 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
 
 // The file feeder of a RunSession: the selected modules' files, each through its input
 // checks, merged by time and pushed in blocks.
+RunRequest calibration_run_request(const Manifest& m, std::vector<std::string> modules, double output_interval) {
+  RunRequest req;
+  req.manifest = m;
+  req.modules = std::move(modules);
+  req.calibration = CalibrationMode::kManifest;
+  req.data_checks = false;
+  req.progress = false;
+  req.nav.output_interval = output_interval;
+  req.warn = [](const std::string&) {};
+  return req;
+}
+
 RunResult run_navigation(const RunRequest& r) {
   RunSession session(r);
   std::vector<std::unique_ptr<ImuStream>> readers;

@@ -78,6 +78,12 @@ struct RunResult {
 /// work, its files appear together at the end (or not at all).
 RunResult run_navigation(const RunRequest& request);
 
+/// A run a calibration makes for its own use: `modules` of `m` with the manifest's
+/// installation as it is (CalibrationMode::kManifest), no data checks, no progress, its
+/// warnings dropped (they belong to the user's own run), the records every `output_interval`
+/// seconds (0: every epoch).
+RunRequest calibration_run_request(const Manifest& m, std::vector<std::string> modules, double output_interval);
+
 /// The checks of a request before any work (InputError naming what is wrong): modules
 /// known and listed once, formats listed once, the numbers in their ranges, the
 /// centralized filter on several modules, every module's rate above the gap threshold.

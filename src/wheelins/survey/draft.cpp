@@ -32,6 +32,7 @@ void carry_over(const ModuleSpec& from, ModuleSpec& to) {
   to.axle_sign = from.axle_sign;
   to.wheel_radius = from.wheel_radius;
   to.odometry_radius = from.odometry_radius;
+  to.yaw_scale = from.yaw_scale;
   if (from.gyro_range > 0.0) to.gyro_range = from.gyro_range;
   if (from.accel_range > 0.0) to.accel_range = from.accel_range;
   to.noise = from.noise;
