@@ -137,8 +137,6 @@ std::vector<fs::path> run_output_files(const RunRequest& r) {
   return files;
 }
 
-// The file feeder of a RunSession: the selected modules' files, each through its input
-// checks, merged by time and pushed in blocks.
 RunRequest calibration_run_request(const Manifest& m, std::vector<std::string> modules, double output_interval) {
   RunRequest req;
   req.manifest = m;
@@ -151,6 +149,8 @@ RunRequest calibration_run_request(const Manifest& m, std::vector<std::string> m
   return req;
 }
 
+// The file feeder of a RunSession: the selected modules' files, each through its input
+// checks, merged by time and pushed in blocks.
 RunResult run_navigation(const RunRequest& r) {
   RunSession session(r);
   std::vector<std::unique_ptr<ImuStream>> readers;
