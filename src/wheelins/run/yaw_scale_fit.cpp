@@ -9,30 +9,9 @@
 
 #include "wheelins/math/rotation.hpp"
 #include "wheelins/run/run.hpp"
+#include "wheelins/survey/clock.hpp"
 
 namespace wheelins {
-namespace {
-
-/// The run's heading, unwrapped, at its records.
-struct HeadingTrack {
-  std::vector<double> t, psi;
-  void add(double time, double heading) {
-    const double h = psi.empty() ? heading : psi.back() + wrap_pi(heading - psi.back());
-    t.push_back(time);
-    psi.push_back(h);
-  }
-  /// Linear at `time`; NaN outside the records.
-  double at(double time) const {
-    const auto it = std::lower_bound(t.begin(), t.end(), time);
-    if (it == t.end() || (it == t.begin() && time < t.front())) return std::nan("");
-    const auto k = static_cast<std::size_t>(it - t.begin());
-    if (k == 0) return psi[0];
-    const double a = (time - t[k - 1]) / (t[k] - t[k - 1]);
-    return (1.0 - a) * psi[k - 1] + a * psi[k];
-  }
-};
-
-}  // namespace
 
 YawScaleFit fit_yaw_scale(const Manifest& m, const std::string& module, const YawScaleFitOptions& o) {
   const ModuleSpec* spec = m.find(module);
@@ -44,8 +23,12 @@ YawScaleFit fit_yaw_scale(const Manifest& m, const std::string& module, const Ya
   RunEvaluationRequest ev;
   ev.keep_series = true;
   req.evaluation = ev;
-  HeadingTrack track;
-  req.on_record = [&](const TrajectoryRecord& r) { track.add(r.t, r.rpy.z()); };
+  // The run's heading, unwrapped, at its records (the evaluated epochs lie within them).
+  survey::Signal track;
+  req.on_record = [&](const TrajectoryRecord& r) {
+    track.t.push_back(r.t);
+    track.x.push_back(track.x.empty() ? r.rpy.z() : track.x.back() + wrap_pi(r.rpy.z() - track.x.back()));
+  };
   const RunResult res = run_navigation(req);
   if (!res.evaluation) return out;
 
@@ -54,8 +37,8 @@ YawScaleFit fit_yaw_scale(const Manifest& m, const std::string& module, const Ya
   std::vector<double> y;
   double t0 = std::nan(""), psi0 = 0.0, e_prev = 0.0, lo = 0.0, hi = 0.0;
   for (const eval::EpochError& e : res.evaluation->series) {
+    if (!std::isfinite(e.heading_err)) continue;
     const double psi = track.at(e.t);
-    if (!std::isfinite(e.heading_err) || !std::isfinite(psi)) continue;
     if (std::isnan(t0)) {
       t0 = e.t, psi0 = psi, e_prev = e.heading_err;
     }
