@@ -1,7 +1,8 @@
 // Steered Wheel-IMUs end to end (docs/filter.md section 16) on the simulator's car with
 // Ackermann steering (preset car-steered): a front wheel alone drifts about as a rear wheel,
 // also when the car starts with its wheels turned 20 deg, and the five-IMU configuration
-// navigates without isolating the steered wheels.
+// navigates without isolating the steered wheels; with a wheel that does not steer the
+// steered ones follow the reference rather than make it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,13 +48,16 @@ fs::path dataset(double start_steering_deg) {
 struct Outcome {
   double drift = 0.0;  ///< drift rate [%]
   int isolations = 0;
+  std::vector<WeightSummary> weights;  ///< per module, in the order given
 };
 
-Outcome navigate(const fs::path& dir, const std::vector<std::string>& modules) {
+Outcome navigate(const fs::path& dir, const std::vector<std::string>& modules,
+                 bool steered_in_reference = false) {
   const Manifest m = load_manifest(dir / "manifest.yaml", {});
   RunRequest r;
   r.manifest = m;
   r.modules = modules;
+  r.nav.fusion.steered_in_reference = steered_in_reference;
   r.progress = false;
   r.warn = [](const std::string&) {};
   eval::RunEvaluationOptions o;
@@ -63,6 +67,7 @@ Outcome navigate(const fs::path& dir, const std::vector<std::string>& modules) {
   const RunResult res = run_navigation(r);
   Outcome out;
   out.drift = 100.0 * e.finish().drift_rate;
+  out.weights = res.weight_summary;
   for (const auto& ev : res.fault_events)
     if (ev.what.find("isolated") != std::string::npos || ev.action.find("isolated") != std::string::npos)
       ++out.isolations;
@@ -97,4 +102,25 @@ TEST(SteeredWheels, FourHubsAndTheBodyKeepTheSteeredWheels) {
   const Outcome front = navigate(dir, {"front-right-C1"});
   EXPECT_EQ(five.isolations, 0);
   EXPECT_LT(five.drift, front.drift);
+}
+
+TEST(SteeredWheels, TheSteeredWheelsFollowWhileAnUnsteeredWheelCounts) {
+  // docs/filter.md section 16: with the rear wheels counted the front ones are tied to the
+  // reference of eq. (8) but have no weight in it; fusion.steered_in_reference gives them
+  // theirs; without an unsteered wheel (the body and the front pair) they make it.
+  const fs::path dir = dataset(0.0);
+  const std::vector<std::string> five = {"body-C1", "left-C1", "right-C1", "front-left-C1", "front-right-C1"};
+  const Outcome follow = navigate(dir, five);
+  ASSERT_EQ(follow.weights.size(), 5u);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(follow.weights[i].mean, 1.0 / 3.0, 0.01) << five[i];
+  for (int i = 3; i < 5; ++i) EXPECT_EQ(follow.weights[i].max, 0.0) << five[i];
+  const Outcome count = navigate(dir, five, true);
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(count.weights[i].mean, 0.2, 0.01) << five[i];
+  const Outcome front = navigate(dir, {"body-C1", "front-left-C1", "front-right-C1"});
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(front.weights[i].mean, 1.0 / 3.0, 0.01);
+  // Followers or not, the steered wheels are constrained: the five drift less than the rear
+  // Triple's 1.05x and less than a front wheel alone.
+  const Outcome triple = navigate(dir, {"body-C1", "left-C1", "right-C1"});
+  EXPECT_LT(follow.drift, 1.05 * triple.drift) << "five " << follow.drift << " %, Triple " << triple.drift << " %";
+  EXPECT_LT(follow.drift, navigate(dir, {"front-left-C1"}).drift);
 }

@@ -59,6 +59,11 @@ struct FusionOptions {
   double heading_offset_window = 30.0;
   /// One joint covariance over all IMUs (Section VI-B-2) instead of one per subsystem.
   bool centralized = false;
+  /// A steered wheel's reference point o and heading rest on its estimated steering angle,
+  /// whose errors (tyre slip angles, caster, toe) nothing models: false (the default) ties it
+  /// to the vehicle without letting it make the reference of eq. (8) or the output while a
+  /// Wheel-IMU that does not steer counts (Subsystems::follows); true counts it as any other.
+  bool steered_in_reference = false;
 };
 
 /// The noise model learned from the data (noise_adaptation.hpp, docs/filter.md section 13).

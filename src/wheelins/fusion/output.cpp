@@ -94,16 +94,20 @@ bool OutputFusion::heading_offset(int i, double& offset) const {
 void OutputFusion::track_offsets(double t, const Use& vehicle, const Records& recs) {
   const int n = subs_.size();
   if (n < 2) return;
+  // The offsets are to the mean of all of them that make the vehicle (not the steered wheels
+  // that follow, Subsystems::follows, whose own offsets are not kept).
   for (int i = 0; i < n; ++i)
-    if (!vehicle[i]) return;  // the offsets are to the mean of all of them
+    if (vehicle[i] == subs_.follows(i)) return;
   double s = 0.0, c = 0.0;
   for (int i = 0; i < n; ++i) {
+    if (!vehicle[i]) continue;
     s += subs_.weight(i) * std::sin(recs[i].rpy.z());
     c += subs_.weight(i) * std::cos(recs[i].rpy.z());
   }
   const double mean = std::atan2(s, c);
   const double a = std::clamp((t - offset_t_) / offset_window_, 0.0, 1.0);
   for (int i = 0; i < n; ++i) {
+    if (!vehicle[i]) continue;
     // A new (or forgotten) offset starts from its present value.
     offset_[i] += (offset_valid_[i] ? a : 1.0) * wrap_pi(wrap_pi(recs[i].rpy.z() - mean) - offset_[i]);
     offset_valid_[i] = true;
@@ -168,8 +172,12 @@ TrajectoryRecord OutputFusion::fuse(const Use& use, const Records& recs) const {
   r.v_std = v_std;
   r.rpy.z() = std::atan2(s, c);
   r.rpy_std.z() = psi_std;
-  bool known = n_use < subs_.size();
-  for (int i = 0; i < subs_.size(); ++i) known = known && offset_valid_[i];
+  // Known when modules that make the vehicle are missing and every one of them, and every
+  // one in `use`, has an offset (a steered wheel that follows has none).
+  bool known = false;
+  for (int i = 0; i < subs_.size(); ++i) known = known || (!use[i] && !subs_.follows(i));
+  for (int i = 0; i < subs_.size(); ++i)
+    if (use[i] || !subs_.follows(i)) known = known && offset_valid_[i];
   if (known) {
     // Modules are missing: psi_i = psi_all + offset_i, so the mean of all of them is the mean
     // of these less the mean of their offsets (the heading goes on as if they were there).

@@ -49,7 +49,8 @@ class OutputFusion {
   void collect(const Use& use, const Use* also, Records& recs) const;
   /// The mean from records already made (recs[i] valid where use[i], and recs[first]).
   TrajectoryRecord fuse(const Use& use, const Records& recs) const;
-  /// With every subsystem in `vehicle`, the offsets move toward their headings' at time t.
+  /// With every subsystem that makes the vehicle in `vehicle` (the steered wheels that follow
+  /// not), their offsets move toward their headings' at time t.
   void track_offsets(double t, const Use& vehicle, const Records& recs);
 
   const Subsystems& subs_;

@@ -59,6 +59,10 @@ Subsystems::Subsystems(const VehicleSetup& setup, const std::vector<std::string>
     throw InputError(std::to_string(subs_.size()) + " modules selected; at most " +
                      std::to_string(kMaxModules) + " can be fused");
   for (int i = 0; i < size(); ++i) wheel_[i] = wheels[i];
+  bool unsteered = false;
+  for (int i = 0; i < size(); ++i) unsteered = unsteered || (is_wheel(i) && !wheel(i).steered());
+  for (int i = 0; i < size(); ++i)
+    follows_[i] = unsteered && !opt.fusion.steered_in_reference && is_wheel(i) && wheel(i).steered();
 }
 
 void Subsystems::set_weights(const std::array<double, kMaxModules>& k) {

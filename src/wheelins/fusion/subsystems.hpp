@@ -40,12 +40,17 @@ class Subsystems {
   double weight(int i) const { return weights_[i]; }
   /// Replaces the weights (each > 0, normalised here to a sum of 1).
   void set_weights(const std::array<double, kMaxModules>& k);
+  /// Subsystem i is a steered wheel that follows: tied to the reference of eq. (8) but not in
+  /// it, nor in the output, while a Wheel-IMU that does not steer counts (the configuration
+  /// has one and FusionOptions::steered_in_reference is off; AidContext::reference_modules).
+  bool follows(int i) const { return follows_[i]; }
   /// Where subsystem i's samples come from (e.g. its file).
   const std::string& source(int i) const { return sources_[i]; }
 
  private:
   std::vector<std::unique_ptr<Subsystem>> subs_;
   std::array<WheelIns*, kMaxModules> wheel_{};
+  std::array<bool, kMaxModules> follows_{};
   BodyIns* body_ = nullptr;
   int body_index_ = -1;
   std::vector<double> weights_;

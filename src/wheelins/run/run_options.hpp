@@ -307,6 +307,12 @@ void declare_fusion_options(V& v, RunConfig& c) {
   v.flag({"fusion.centralized", "one joint covariance (paper Section VI-B-2); not on a single module",
           "--centralized"},
          f.centralized);
+  v.flag({"fusion.steered_in_reference",
+          "a steered wheel's IMU counts in the reference point of eq. (8) and the output as any other "
+          "(default: it is tied to them and follows while a wheel that does not steer counts; docs/filter.md "
+          "section 16)",
+          "--steered-in-reference"},
+         f.steered_in_reference);
 }
 
 /// noise: the noise model identified from the data (docs/filter.md section 13).

@@ -77,13 +77,32 @@ struct AidContext {
     for (int i = 0; i < subs.size(); ++i) use[i] = faults.in_use(i);
     return use;
   }
-  /// Which modules the vehicle solution is made of now (those counted, else those in use).
-  ModuleMask vehicle_modules() const {
+  /// Which modules make the reference of eq. (8) now: those counted, less the steered wheels
+  /// that follow (Subsystems::follows) while a Wheel-IMU that does not steer is counted.
+  ModuleMask reference_modules() const {
     ModuleMask use{};
-    bool any = false;
-    for (int i = 0; i < subs.size(); ++i) any |= use[i] = faults.counted(i);
-    if (!any) use = in_use();
+    bool unsteered = false;
+    for (int i = 0; i < subs.size(); ++i) {
+      use[i] = faults.counted(i);
+      unsteered = unsteered || (use[i] && subs.is_wheel(i) && !subs.wheel(i).steered());
+    }
+    if (unsteered)
+      for (int i = 0; i < subs.size(); ++i) use[i] = use[i] && !subs.follows(i);
     return use;
+  }
+  /// Which modules the vehicle solution is made of now (the reference's, else those in use).
+  ModuleMask vehicle_modules() const { return or_in_use(reference_modules()); }
+  /// Which modules are in good health now (those counted, else those in use).
+  ModuleMask counted_modules() const {
+    ModuleMask use{};
+    for (int i = 0; i < subs.size(); ++i) use[i] = faults.counted(i);
+    return or_in_use(use);
+  }
+  /// `use`, or the modules in use when it holds none.
+  ModuleMask or_in_use(const ModuleMask& use) const {
+    for (int i = 0; i < subs.size(); ++i)
+      if (use[i]) return use;
+    return in_use();
   }
   /// Time of the subsystem in use that is furthest behind.
   double min_time() const {

@@ -18,7 +18,8 @@ PositionConstraintAid::PositionConstraintAid(const AidContext& ctx)
 
 void PositionConstraintAid::step() {
   // Algorithm 1 over the modules in good health: their weighted mean of o (eq. 8) is the
-  // reference; modules on probation are tied to it without moving it.
+  // reference; modules on probation and steered wheels that follow are tied to it without
+  // moving it.
   SharedInputs& sh = ctx_.shared;
   int n_ref = 0, n_tied = 0;
   if (weights_.from_covariance() || weights_.from_standalone()) update_weights();
@@ -68,8 +69,9 @@ void PositionConstraintAid::update_weights() {
   }
   SharedInputs& sh = ctx_.shared;
   take_reference(sh, false);  // every o and its H_mlt at the current state
+  const ModuleMask ref = ctx_.reference_modules();
   for (int i = 0; i < subs.size(); ++i) {
-    const bool counted = ctx_.faults.counted(i);
+    const bool counted = ref[i];
     weights_.observe(i, counted ? reference_point_variance(sh.ref[i], ctx_.filter.covariance(i, scratch)) : 0.0,
                      counted);
   }
@@ -78,13 +80,15 @@ void PositionConstraintAid::update_weights() {
 
 bool PositionConstraintAid::reference_weights(std::array<double, kMaxModules>& k, int& n_ref,
                                               int& n_tied) const {
-  // The weights of eq. (8) renormalised over the modules in good health (0 for the others).
+  // The weights of eq. (8) renormalised over the modules in good health that make the
+  // reference (0 for the others: out, on probation, or a steered wheel that follows).
   const int n = ctx_.subs.size();
+  const ModuleMask ref = ctx_.reference_modules();
   k.fill(0.0);
   double ksum = 0.0;
   n_ref = n_tied = 0;
   for (int i = 0; i < n; ++i) {
-    if (ctx_.faults.counted(i)) {
+    if (ref[i]) {
       k[i] = ctx_.subs.weight(i);
       ksum += k[i];
       ++n_ref;

@@ -19,7 +19,7 @@ class ZeroMotionAid {
   void add(int i, const ImuSample& b) { standstill_.add(i, b, ctx_.subs[i].ekf().errors()); }
   /// At a velocity-update epoch at time t: whether the vehicle (the modules it is made of)
   /// stands.
-  bool standing(double t) { return standstill_.evaluate(ctx_.vehicle_modules(), ctx_.subs.size(), t); }
+  bool standing(double t) { return standstill_.evaluate(ctx_.counted_modules(), ctx_.subs.size(), t); }
   /// The zero velocity and rate updates of every quiet subsystem in use.
   void step();
   /// Updates fused and epochs at which the vehicle stood.
