@@ -113,9 +113,13 @@ TEST(SteeredWheels, TheSteeredWheelsFollowWhileAnUnsteeredWheelCounts) {
   const Outcome follow = navigate(dir, five);
   ASSERT_EQ(follow.weights.size(), 5u);
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(follow.weights[i].mean, 1.0 / 3.0, 0.01) << five[i];
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(follow.weights[i].follows, i >= 3) << five[i];
   for (int i = 3; i < 5; ++i) EXPECT_EQ(follow.weights[i].max, 0.0) << five[i];
   const Outcome count = navigate(dir, five, true);
-  for (int i = 0; i < 5; ++i) EXPECT_NEAR(count.weights[i].mean, 0.2, 0.01) << five[i];
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_NEAR(count.weights[i].mean, 0.2, 0.01) << five[i];
+    EXPECT_FALSE(count.weights[i].follows) << five[i];
+  }
   const Outcome front = navigate(dir, {"body-C1", "front-left-C1", "front-right-C1"});
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(front.weights[i].mean, 1.0 / 3.0, 0.01);
   // Followers or not, the steered wheels are constrained: the five drift less than the rear

@@ -71,6 +71,8 @@ class Navigator {
   /// for the per-sample checks).
   double start_time() const { return stats_.t_start; }
   int subsystem_count() const { return subs_.size(); }
+  /// Subsystem i is a steered wheel that follows the others (Subsystems::follows).
+  bool follows(int i) const { return subs_.follows(i); }
   const Subsystem& subsystem(int i) const { return subs_.at(i); }
   Subsystem& subsystem(int i) { return subs_.at(i); }
   /// The measurements of subsystem i as this navigator's filter would fuse them now, at the

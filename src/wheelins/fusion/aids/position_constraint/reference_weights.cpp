@@ -112,7 +112,8 @@ std::string weights_csv(const std::vector<WeightRecord>& history,
 }
 
 std::string weights_report(const std::vector<WeightRecord>& history,
-                           const std::vector<std::string>& modules, const FusionOptions& options) {
+                           const std::vector<std::string>& modules, const FusionOptions& options,
+                           const std::vector<bool>& follows) {
   if (history.empty()) return "";
   const int n = static_cast<int>(modules.size());
   const std::vector<WeightSummary> s = summarize_weights(history, n);
@@ -129,7 +130,9 @@ std::string weights_report(const std::vector<WeightRecord>& history,
     std::snprintf(buf, sizeof buf, "  %-12s %.3f [%.3f, %.3f]", modules[i].c_str(), s[i].mean, s[i].min,
                   s[i].max);
     out += buf;
-    if (s[i].counted < 1.0) {
+    if (static_cast<std::size_t>(i) < follows.size() && follows[i]) {
+      out += "  (steered: follows the wheels that do not steer; --steered-in-reference counts it)";
+    } else if (s[i].counted < 1.0) {
       std::snprintf(buf, sizeof buf, "  (counted in %.1f %% of the epochs)", 100.0 * s[i].counted);
       out += buf;
     }

@@ -107,14 +107,18 @@ class ReferenceWeights {
 /// it counted, and the share of epochs it counted.
 struct WeightSummary {
   double mean = 0.0, min = 0.0, max = 0.0, counted = 0.0;
+  /// A steered wheel that follows (Subsystems::follows): tied to the reference, never in it.
+  bool follows = false;
 };
 std::vector<WeightSummary> summarize_weights(const std::vector<WeightRecord>& history, int n);
 
 /// weights.csv: `t,<module>...`, one row per constraint epoch.
 std::string weights_csv(const std::vector<WeightRecord>& history,
                         const std::vector<std::string>& modules);
-/// A few lines for the run's printout: how the weights were made and their summary.
+/// A few lines for the run's printout: how the weights were made and their summary;
+/// `follows[i]`: module i is a steered wheel that follows (may be empty: none).
 std::string weights_report(const std::vector<WeightRecord>& history,
-                           const std::vector<std::string>& modules, const FusionOptions& options);
+                           const std::vector<std::string>& modules, const FusionOptions& options,
+                           const std::vector<bool>& follows = {});
 
 }  // namespace wheelins
