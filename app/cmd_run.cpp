@@ -78,7 +78,7 @@ void print_run_summary(const RunRequest& req, const RunResult& res) {
     const std::vector<WeightSummary>& s = res.weight_summary;
     std::cout << "reference weights k_i (eq. 8), mean:";
     for (std::size_t i = 0; i < s.size(); ++i)
-      if (s[i].follows) std::printf("%s %s follows (steered)", i ? "," : "", req.modules[i].c_str());
+      if (s[i].follows && s[i].counted == 0.0) std::printf("%s %s follows (steered)", i ? "," : "", req.modules[i].c_str());
       else std::printf("%s %s %.3f", i ? "," : "", req.modules[i].c_str(), s[i].mean);
     std::cout << " (weights.csv)\n";
   }

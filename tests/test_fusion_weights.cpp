@@ -134,7 +134,7 @@ TEST(ReferenceWeights, FixedWeightsAreKeptAndRecorded) {
   EXPECT_DOUBLE_EQ(s[1].max, 1.0);
   EXPECT_EQ(weights_csv(w.history(), {"left-C1", "right-C1"}),
             "t,left-C1,right-C1\n10.000,0.250000,0.750000\n11.000,0.000000,1.000000\n");
-  const std::string text = weights_report(w.history(), {"left-C1", "right-C1"}, o);
+  const std::string text = weights_report(s, w.history().size(), {"left-C1", "right-C1"}, o);
   EXPECT_NE(text.find("equal"), std::string::npos) << text;
   EXPECT_NE(text.find("left-C1      0.250 [0.250, 0.250]  (counted in 50.0 % of the epochs)"),
             std::string::npos)

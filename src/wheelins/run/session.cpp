@@ -238,9 +238,8 @@ RunResult RunSession::finish(double process_seconds, const std::vector<SessionIn
   result.weights = nav_->weight_history();
   std::vector<bool> follows(req_.modules.size());
   for (int i = 0; i < nav_->subsystem_count(); ++i) follows[i] = nav_->follows(i);
-  result.weights_report = weights_report(result.weights, req_.modules, req_.nav.fusion, follows);
-  result.weight_summary = summarize_weights(result.weights, static_cast<int>(req_.modules.size()));
-  for (std::size_t i = 0; i < result.weight_summary.size(); ++i) result.weight_summary[i].follows = follows[i];
+  result.weight_summary = summarize_weights(result.weights, static_cast<int>(req_.modules.size()), follows);
+  result.weights_report = weights_report(result.weight_summary, result.weights.size(), req_.modules, req_.nav.fusion);
   result.fault_report = fault_report_text(nav_->faults());
   if (!input_faults.empty()) {
     if (result.fault_report.rfind("faults: none detected", 0) == 0)

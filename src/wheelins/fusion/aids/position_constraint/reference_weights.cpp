@@ -73,8 +73,10 @@ void ReferenceWeights::record(double t, const std::array<double, kMaxModules>& k
   history_.push_back(r);
 }
 
-std::vector<WeightSummary> summarize_weights(const std::vector<WeightRecord>& history, int n) {
+std::vector<WeightSummary> summarize_weights(const std::vector<WeightRecord>& history, int n,
+                                             const std::vector<bool>& follows) {
   std::vector<WeightSummary> s(n);
+  for (int i = 0; i < n && static_cast<std::size_t>(i) < follows.size(); ++i) s[i].follows = follows[i];
   std::vector<int> count(n, 0);
   for (int i = 0; i < n; ++i) s[i].min = 1.0;
   for (const WeightRecord& r : history)
@@ -111,27 +113,28 @@ std::string weights_csv(const std::vector<WeightRecord>& history,
   return out;
 }
 
-std::string weights_report(const std::vector<WeightRecord>& history,
-                           const std::vector<std::string>& modules, const FusionOptions& options,
-                           const std::vector<bool>& follows) {
-  if (history.empty()) return "";
+std::string weights_report(const std::vector<WeightSummary>& s, std::size_t epochs,
+                           const std::vector<std::string>& modules, const FusionOptions& options) {
+  if (epochs == 0) return "";
   const int n = static_cast<int>(modules.size());
-  const std::vector<WeightSummary> s = summarize_weights(history, n);
   std::string out = std::string("reference weights k_i (eq. 8, ") +
                     (options.weighting == ReferenceWeighting::kCovariance
                          ? "inverse variance of each subsystem's o"
                          : options.weighting == ReferenceWeighting::kStandalone
                                ? "inverse of each subsystem's drift on its own"
                                : (options.weights.empty() ? "equal" : "fixed")) +
-                    "), mean [least, greatest] over " + std::to_string(history.size()) +
+                    "), mean [least, greatest] over " + std::to_string(epochs) +
                     " constraint epochs:\n";
   char buf[160];
   for (int i = 0; i < n; ++i) {
     std::snprintf(buf, sizeof buf, "  %-12s %.3f [%.3f, %.3f]", modules[i].c_str(), s[i].mean, s[i].min,
                   s[i].max);
     out += buf;
-    if (static_cast<std::size_t>(i) < follows.size() && follows[i]) {
-      out += "  (steered: follows the wheels that do not steer; --steered-in-reference counts it)";
+    if (s[i].follows) {
+      // It counts only while no wheel that does not steer does (fault handling).
+      std::snprintf(buf, sizeof buf, "  (steered: follows the wheels that do not steer, counted in %.1f %% of the epochs; "
+                    "--steered-in-reference counts it)", 100.0 * s[i].counted);
+      out += buf;
     } else if (s[i].counted < 1.0) {
       std::snprintf(buf, sizeof buf, "  (counted in %.1f %% of the epochs)", 100.0 * s[i].counted);
       out += buf;

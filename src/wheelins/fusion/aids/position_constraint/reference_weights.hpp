@@ -110,15 +110,16 @@ struct WeightSummary {
   /// A steered wheel that follows (Subsystems::follows): tied to the reference, never in it.
   bool follows = false;
 };
-std::vector<WeightSummary> summarize_weights(const std::vector<WeightRecord>& history, int n);
+/// `follows[i]`: module i is a steered wheel that follows (may be empty: none).
+std::vector<WeightSummary> summarize_weights(const std::vector<WeightRecord>& history, int n,
+                                             const std::vector<bool>& follows = {});
 
 /// weights.csv: `t,<module>...`, one row per constraint epoch.
 std::string weights_csv(const std::vector<WeightRecord>& history,
                         const std::vector<std::string>& modules);
-/// A few lines for the run's printout: how the weights were made and their summary;
-/// `follows[i]`: module i is a steered wheel that follows (may be empty: none).
-std::string weights_report(const std::vector<WeightRecord>& history,
-                           const std::vector<std::string>& modules, const FusionOptions& options,
-                           const std::vector<bool>& follows = {});
+/// A few lines for the run's printout: how the weights were made and their summary `s`
+/// (summarize_weights) over `epochs` constraint epochs ("" when there were none).
+std::string weights_report(const std::vector<WeightSummary>& s, std::size_t epochs,
+                           const std::vector<std::string>& modules, const FusionOptions& options);
 
 }  // namespace wheelins
