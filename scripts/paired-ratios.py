@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Paired drift ratios of a study (docs/studies.md): for each pair A:B, the drift rate of B
+over that of A on the same data (same condition, seed and chips), per condition and over all:
+how many pairs are "no worse" (ratio <= --bound, default 1.05), the geometric mean of the
+ratios, the worst and the best. A may be min(X,Y,...): per data set the lowest drift of those
+configurations (e.g. "the best three-IMU configuration").
+
+  scripts/paired-ratios.py RESULTS/jobs.csv rear:front 'min(rear-triple,front-triple):five'
+
+The figures of docs/accuracy.md's paired tables come from it. Jobs that are not done are
+left out and counted on standard error; a pair whose A or B is missing is left out."""
+
+import argparse
+import csv
+import math
+import sys
+
+def read_jobs(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        raise ValueError(f"{path}: no jobs")
+    columns = list(rows[0].keys())
+    for needed in ("job", "seed", "configuration", "state", "drift_rate_pct"):
+        if needed not in columns:
+            raise ValueError(f"{path}: no column '{needed}'")
+    axes = columns[1:columns.index("seed")]
+    chips = [c for c in ("chips",) if c in columns]
+    data = {}
+    skipped = 0
+    for line, r in enumerate(rows, start=2):
+        if r["state"] != "done":
+            skipped += 1
+            continue
+        try:
+            drift = float(r["drift_rate_pct"])
+        except ValueError:
+            raise ValueError(f"{path}: line {line}: drift_rate_pct '{r['drift_rate_pct']}' is not a number")
+        if not drift > 0.0 or math.isinf(drift):
+            raise ValueError(f"{path}: line {line}: drift_rate_pct {drift} is not a positive number")
+        condition = tuple(r[a] for a in axes)
+        key = (condition, r["seed"]) + tuple(r[c] for c in chips)
+        data.setdefault(key, {})[r["configuration"]] = drift
+    return axes, data, skipped
+
+
+def side(spec, runs):
+    """The drift of one side of a pair on one data set, or None when a configuration is missing."""
+    if spec.startswith("min(") and spec.endswith(")"):
+        names = [n.strip() for n in spec[4:-1].split(",")]
+        values = [runs.get(n) for n in names]
+        return None if any(v is None for v in values) else min(values)
+    return runs.get(spec)
+
+
+def split_pair(pair):
+    """A:B split at the colon outside parentheses; None unless there is exactly one."""
+    depth, cut = 0, []
+    for i, ch in enumerate(pair):
+        depth += (ch == "(") - (ch == ")")
+        if ch == ":" and depth == 0:
+            cut.append(i)
+    if len(cut) != 1 or cut[0] in (0, len(pair) - 1):
+        return None
+    return pair[:cut[0]], pair[cut[0] + 1:]
+
+
+def summary(ratios, bound):
+    if not ratios:
+        return "no pairs"
+    geo = math.exp(sum(math.log(x) for x in ratios) / len(ratios))
+    no_worse = sum(x <= bound for x in ratios)
+    return (f"{no_worse} of {len(ratios)} no worse ({100.0 * no_worse / len(ratios):.0f} %), "
+            f"geo-mean {geo:.2f}, worst {max(ratios):.2f}, best {min(ratios):.2f}")
+
+
+def main(argv):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("jobs", help="a study's jobs.csv")
+    p.add_argument("pairs", nargs="+", help="A:B (B over A); A or B may be min(X,Y,...)")
+    p.add_argument("--bound", type=float, default=1.05, help="the largest ratio counted as no worse")
+    a = p.parse_args(argv)
+    try:
+        axes, data, skipped = read_jobs(a.jobs)
+    except (OSError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    if skipped:
+        print(f"{a.jobs}: {skipped} jobs not done, left out", file=sys.stderr)
+    known = set(c for runs in data.values() for c in runs)
+    for pair in a.pairs:
+        halves = split_pair(pair)
+        if halves is None:
+            print(f"error: pair '{pair}' is not A:B", file=sys.stderr)
+            return 2
+        first, second = halves
+        for spec in (first, second):
+            names = spec[4:-1].split(",") if spec.startswith("min(") else [spec]
+            for n in names:
+                if n.strip() not in known:
+                    print(f"error: {a.jobs}: no configuration '{n.strip()}' (there are: {', '.join(sorted(known))})",
+                          file=sys.stderr)
+                    return 2
+        by_condition = {}
+        for (condition, *_), runs in sorted(data.items()):
+            lo, hi = side(first, runs), side(second, runs)
+            if lo is not None and hi is not None:
+                by_condition.setdefault(condition, []).append(hi / lo)
+        print(f"{second} against {first}: {summary([x for v in by_condition.values() for x in v], a.bound)}")
+        for condition, ratios in by_condition.items():
+            label = ", ".join(f"{ax} {v}" for ax, v in zip(axes, condition))
+            print(f"  {label}: {summary(ratios, a.bound)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
