@@ -16,6 +16,7 @@ namespace {
 
 constexpr double kX = 2.6;    // wheel centre ahead of the rear axle [m]
 constexpr double kDt = 0.005;  // 200 Hz
+constexpr double kRadius = 0.35;  // wheel radius [m]
 
 struct Drive {
   std::function<double(double)> delta;  // true steering [rad]
@@ -24,20 +25,26 @@ struct Drive {
 
 struct Result {
   double max_error_after = 0.0;  // |delta_hat - delta| after `settle_t` [rad]
-  double turn = 0.0;             // the onset's turn of the wheel's navigation
+  double turn = 0.0;             // the onset's turns of the wheel's navigation, summed
   double vehicle_heading_error = 0.0;  // at the end: (wheel heading - delta_hat) - vehicle's
+  double max_heading_error_rolled = 0.0;  // the same, its largest from 0.3 m rolled on
   bool settled = false;
 };
 
 /// Drives for `duration`: the wheel's heading is integrated from its yaw rate, starting at
 /// the vehicle's heading (0) plus the observer's delta (0: the start's unknown), turned by the
 /// observer's onset correction; `reference` passes the true vehicle heading over the onset.
-Result drive(const Drive& d, double duration, double settle_t, bool reference) {
-  SteeringObserver obs(kX, SteeringOptions{});
+/// `misalignment`: the IMU's axes off the wheel's by this angle [rad], so that the spin leaks
+/// into the yaw rate as misalignment * omega * cos(theta) and into the heading as
+/// misalignment * sin(theta) (theta: the wheel's rotation angle).
+Result drive(const Drive& d, double duration, double settle_t, bool reference, double misalignment = 0.0) {
+  SteeringObserver obs(kX, kRadius, SteeringOptions{});
   obs.arm(0.0);
   Result r;
   double psi_v = 0.0;            // true vehicle heading
   double psi_w = obs.angle();    // the wheel's navigated heading (vehicle's + delta_hat)
+  double theta = 0.0;            // the wheel's rotation angle
+  double rolled = 0.0;
   for (double t = 0.0; t < duration; t += kDt) {
     const double v = d.speed(t);
     const double ddelta = (d.delta(t + 1e-6) - d.delta(t - 1e-6)) / 2e-6;
@@ -45,11 +52,18 @@ Result drive(const Drive& d, double duration, double settle_t, bool reference) {
     const double ww = wv + ddelta;                    // wheel yaw rate
     psi_v += wv * kDt;
     psi_w += ww * kDt;
-    const auto st = obs.step(ww, v, kDt, psi_w, reference ? psi_v : SteeringObserver::kNoHeading);
+    const double leak_rate = misalignment * v / kRadius * std::cos(theta);
+    theta += v / kRadius * kDt;
+    const auto st = obs.step(ww + leak_rate, v, kDt, psi_w + misalignment * std::sin(theta),
+                             reference ? psi_v : SteeringObserver::kNoHeading);
     if (st.turn != 0.0) {
-      r.turn = st.turn;
+      r.turn += st.turn;
       psi_w += st.turn;
     }
+    rolled += v * kDt;
+    if (rolled >= 0.3)
+      r.max_heading_error_rolled =
+          std::max(r.max_heading_error_rolled, std::abs(wrap_pi(psi_w - obs.angle() - psi_v)));
     if (t > settle_t)
       r.max_error_after = std::max(r.max_error_after, std::abs(obs.angle() - d.delta(t + kDt)));
   }
@@ -79,8 +93,24 @@ TEST(Steering, StartWithTheWheelsTurnedTwentyDegrees) {
   const Result r = drive(d, 30.0, 4.0, false);
   EXPECT_TRUE(r.settled);
   EXPECT_NEAR(r.turn, 20.0 * kDeg, 0.5 * kDeg);
+  // From 0.3 m rolled on the turn so far sets delta_0, long before the onset's 2.2 m.
+  EXPECT_LT(r.max_heading_error_rolled, 1.0 * kDeg);
   EXPECT_LT(r.max_error_after, 0.5 * kDeg);
   EXPECT_LT(std::abs(r.vehicle_heading_error), 0.5 * kDeg);
+}
+
+TEST(Steering, TheStartsTurnIsMeasuredOverWholeRevolutions) {
+  // The IMU 0.1 deg off the wheel's axes: over the 0.5 m asked (0.23 of a revolution) the
+  // spin's leak would be up to 0.1 deg of false turn, 0.5 deg of delta_0; the onset rolls
+  // one whole revolution instead, over which it cancels. The same with another IMU's heading.
+  Drive d{[](double) { return 20.0 * kDeg; }, [](double t) { return 3.0 * ramp(t, 1.0, 4.0); }};
+  const Result alone = drive(d, 20.0, 6.0, false, 0.1 * kDeg);
+  const Result referenced = drive(d, 20.0, 6.0, true, 0.1 * kDeg);
+  for (const Result* r : {&alone, &referenced}) {
+    EXPECT_TRUE(r->settled);
+    EXPECT_NEAR(r->turn, 20.0 * kDeg, 0.1 * kDeg);
+    EXPECT_LT(std::abs(r->vehicle_heading_error), 0.15 * kDeg);
+  }
 }
 
 TEST(Steering, SteeringWhileStartingToRollNeedsAnotherImusHeading) {
@@ -98,7 +128,7 @@ TEST(Steering, SteeringWhileStartingToRollNeedsAnotherImusHeading) {
 
 TEST(Steering, SteeringAtRestTurnsTheWheelOnly) {
   // At rest the wheel's yaw rate is the steering rate: the vehicle's implied yaw rate is 0.
-  SteeringObserver obs(kX, SteeringOptions{});
+  SteeringObserver obs(kX, kRadius, SteeringOptions{});
   obs.arm(0.0);
   for (int k = 0; k < 200; ++k) {
     obs.step(0.2, 0.0, kDt);

@@ -9,6 +9,22 @@
 
 namespace wheelins {
 
+namespace {
+
+/// The smallest whole number of revolutions (at least one) that rolls `distance`.
+double whole_revolutions(double distance, double wheel_radius) {
+  if (!(wheel_radius > 0.0)) return distance;
+  const double circumference = 2.0 * kPi * wheel_radius;
+  return std::max(1.0, std::ceil(distance / circumference - 1e-9)) * circumference;
+}
+
+}  // namespace
+
+SteeringObserver::SteeringObserver(double distance_ahead, double wheel_radius, const SteeringOptions& opt)
+    : x_(distance_ahead), opt_(opt),
+      onset_(whole_revolutions(opt.onset_distance, wheel_radius)),
+      reference_onset_(whole_revolutions(opt.reference_onset_distance, wheel_radius)) {}
+
 SteeringObserver::Step SteeringObserver::step(double wheel_yaw_rate, double speed, double dt,
                                               double wheel_heading, double vehicle_heading) {
   Step out;
@@ -40,6 +56,7 @@ SteeringObserver::Step SteeringObserver::step(double wheel_yaw_rate, double spee
         delta_ = gap;  // for now (the error is added at the end)
         ref_last_ = vehicle_heading;
         if (rolling) {
+          turn_ += wheel_yaw_rate * dt;  // should the reference leave
           gap_sum_ += gap * speed * dt;
           distance_ += speed * dt;
         }
@@ -50,9 +67,17 @@ SteeringObserver::Step SteeringObserver::step(double wheel_yaw_rate, double spee
         if (rolling) {
           turn_ += wheel_yaw_rate * dt;
           distance_ += speed * dt;
+          // Meanwhile the turn so far says delta_0 roughly: the wheel's path (and the
+          // vehicle's point it carries) follows it rather than the armed delta, which can
+          // be tens of degrees off (a car parked with its wheels turned).
+          if (std::abs(distance_) >= opt_.provisional_distance && std::abs(distance_) < onset_) {
+            const double provisional = std::asin(std::clamp(x_ * turn_ / distance_, -0.95, 0.95));
+            out.turn = provisional - delta_;
+            delta_ = provisional;
+          }
         }
       }
-      const double needed = referenced_ ? opt_.reference_onset_distance : opt_.onset_distance;
+      const double needed = referenced_ ? reference_onset_ : onset_;
       if (std::abs(distance_) >= needed) {
         double delta_end = 0.0;
         if (referenced_) {

@@ -33,14 +33,27 @@
 //    wheel: the steering held while the car starts to roll), then delta_0 =
 //    asin(x * turn / distance) from the wheel's turn over that distance. A driver who steers
 //    while starting to roll leaves an error of the steering's change in the heading (in a
-//    local frame, a turn of the whole path after the first metres).
+//    local frame, a turn of the whole path after the first metres). Until the end of the
+//    onset, the turn so far sets delta_0 from `provisional_distance` on, so that the wheel's
+//    path (and the vehicle's point) is not carried off by the armed delta meanwhile.
+// Both onsets last a whole number of wheel revolutions (at least the distance asked): the
+// IMU's axes are never exactly the wheel's (mounting residuals, the gyro's non-orthogonal
+// axes), so the spin leaks into the yaw rate and the heading the wheel reports as a
+// sinusoid of the wheel's rotation angle, of amplitude the misalignment. Over a part of a
+// revolution it does not cancel: 0.05 deg of misalignment is up to 0.1 deg of false turn,
+// which over half a metre is 0.5 deg of delta_0 on a car (x = 2.6 m); over whole
+// revolutions it cancels.
 #pragma once
 
 namespace wheelins {
 
 struct SteeringOptions {
-  double onset_distance = 0.5;    ///< rolled before delta_0 is taken from the turn [m]
-  double reference_onset_distance = 2.0;  ///< ... from another IMU's heading [m]
+  /// Rolled before delta_0 is taken from the turn [m], rounded up to whole revolutions.
+  double onset_distance = 0.5;
+  double reference_onset_distance = 2.0;  ///< ... from another IMU's heading [m], the same
+  /// Alone, from this distance rolled on, the turn so far sets delta_0 at every epoch until
+  /// the onset's end measures it [m].
+  double provisional_distance = 0.1;
   double standstill_speed = 0.05;  ///< below it the wheel stands [m/s]
 };
 
@@ -54,9 +67,9 @@ class SteeringObserver {
   };
 
   SteeringObserver() = default;
-  /// `distance_ahead`: the wheel centre's distance ahead of the rear axle [m] (> 0).
-  SteeringObserver(double distance_ahead, const SteeringOptions& opt)
-      : x_(distance_ahead), opt_(opt) {}
+  /// `distance_ahead`: the wheel centre's distance ahead of the rear axle [m] (> 0);
+  /// `wheel_radius` [m] (> 0) sets the onsets' whole revolutions.
+  SteeringObserver(double distance_ahead, double wheel_radius, const SteeringOptions& opt);
 
   /// A new start (or restart): delta from `delta` until the onset measures it.
   void arm(double delta) {
@@ -86,6 +99,7 @@ class SteeringObserver {
   enum class Phase { kStanding, kOnset, kTracking };
   double x_ = 1.0;
   SteeringOptions opt_;
+  double onset_ = 0.5, reference_onset_ = 2.0;  // the onsets' distances: whole revolutions
   double delta_ = 0.0, rate_ = 0.0;
   Phase phase_ = Phase::kStanding;
   double turn_ = 0.0, distance_ = 0.0;  // over the onset: the wheel's turn, its signed travel

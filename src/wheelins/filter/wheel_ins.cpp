@@ -18,7 +18,7 @@ WheelIns::WheelIns(const ImuModule& module, const WheelInsOptions& opt,
   // averages for it.
   if (module.steered) {
     opt_.turn_average = false;
-    steer_ = SteeringObserver(module.p_inV.x(), opt.steering);
+    steer_ = SteeringObserver(module.p_inV.x(), module.wheel_radius, opt.steering);
   }
   // Its b x-axis is the axle: the attitude update splits the spin off (nav/mechanization.hpp).
   mech_.spin_about_x = true;
