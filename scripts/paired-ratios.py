@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Paired drift ratios of a study (docs/studies.md): for each pair A:B, the drift rate of B
-over that of A on the same data (same condition, seed and chips), per condition and over all:
+over that of A on the same data (same condition and seed), per condition and over all:
 how many pairs are "no worse" (ratio <= --bound, default 1.05), the geometric mean of the
-ratios, the worst and the best. A may be min(X,Y,...): per data set the lowest drift of those
+ratios, the worst and the best. A or B may be min(X,Y,...): per data set the lowest drift of those
 configurations (e.g. "the best three-IMU configuration").
 
   scripts/paired-ratios.py RESULTS/jobs.csv rear:front 'min(rear-triple,front-triple):five'
@@ -25,7 +25,6 @@ def read_jobs(path):
         if needed not in columns:
             raise ValueError(f"{path}: no column '{needed}'")
     axes = columns[1:columns.index("seed")]
-    chips = [c for c in ("chips",) if c in columns]
     data = {}
     skipped = 0
     for line, r in enumerate(rows, start=2):
@@ -39,18 +38,23 @@ def read_jobs(path):
         if not drift > 0.0 or math.isinf(drift):
             raise ValueError(f"{path}: line {line}: drift_rate_pct {drift} is not a positive number")
         condition = tuple(r[a] for a in axes)
-        key = (condition, r["seed"]) + tuple(r[c] for c in chips)
+        key = (condition, r["seed"])  # the data set: the condition's axes and the seed
         data.setdefault(key, {})[r["configuration"]] = drift
     return axes, data, skipped
 
 
-def side(spec, runs):
-    """The drift of one side of a pair on one data set, or None when a configuration is missing."""
+def configurations(spec):
+    """The configurations one side of a pair names: X, or each of min(X,Y,...)."""
     if spec.startswith("min(") and spec.endswith(")"):
-        names = [n.strip() for n in spec[4:-1].split(",")]
-        values = [runs.get(n) for n in names]
-        return None if any(v is None for v in values) else min(values)
-    return runs.get(spec)
+        return [n.strip() for n in spec[4:-1].split(",")]
+    return [spec]
+
+
+def side(spec, runs):
+    """The drift of one side of a pair on one data set (the lowest of a min(...)), or None when
+    a configuration is missing."""
+    values = [runs.get(n) for n in configurations(spec)]
+    return None if any(v is None for v in values) else min(values)
 
 
 def split_pair(pair):
@@ -94,13 +98,11 @@ def main(argv):
             print(f"error: pair '{pair}' is not A:B", file=sys.stderr)
             return 2
         first, second = halves
-        for spec in (first, second):
-            names = spec[4:-1].split(",") if spec.startswith("min(") else [spec]
-            for n in names:
-                if n.strip() not in known:
-                    print(f"error: {a.jobs}: no configuration '{n.strip()}' (there are: {', '.join(sorted(known))})",
-                          file=sys.stderr)
-                    return 2
+        for n in configurations(first) + configurations(second):
+            if n not in known:
+                print(f"error: {a.jobs}: no configuration '{n}' (there are: {', '.join(sorted(known))})",
+                      file=sys.stderr)
+                return 2
         by_condition = {}
         for (condition, *_), runs in sorted(data.items()):
             lo, hi = side(first, runs), side(second, runs)
