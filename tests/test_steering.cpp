@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <random>
 
 #include "wheelins/filter/steering.hpp"
 #include "wheelins/math/rotation.hpp"
@@ -113,6 +114,21 @@ TEST(Steering, TheStartsTurnIsMeasuredOverWholeRevolutions) {
   }
 }
 
+TEST(Steering, ACarThatCreepsBeforeItRollsTurnsWithTheWheel) {
+  // Wheels turned 20 deg, the car creeps at 4 cm/s for 3 s (12 cm: the vehicle turns 0.9
+  // deg), then drives off. Creeping is rolling: the vehicle turns with the wheel, alone or
+  // with another IMU's heading (taken as steering at rest, the 0.9 deg would stay in the
+  // vehicle's heading).
+  Drive d{[](double) { return 20.0 * kDeg; },
+          [](double t) { return t < 1.0 ? 0.0 : t < 4.0 ? 0.04 : 0.04 + 3.0 * ramp(t, 4.0, 7.0); }};
+  const Result alone = drive(d, 20.0, 9.0, false);
+  const Result referenced = drive(d, 20.0, 9.0, true);
+  for (const Result* r : {&alone, &referenced}) {
+    EXPECT_TRUE(r->settled);
+    EXPECT_LT(std::abs(r->vehicle_heading_error), 0.1 * kDeg);
+  }
+}
+
 TEST(Steering, SteeringWhileStartingToRollNeedsAnotherImusHeading) {
   // The driver turns from 20 deg to 5 deg as the car starts to roll: alone, the onset takes
   // the wheel's turn for the vehicle's and keeps the difference in the heading; with the
@@ -136,4 +152,20 @@ TEST(Steering, SteeringAtRestTurnsTheWheelOnly) {
   }
   EXPECT_NEAR(obs.angle(), 0.2, 1e-12);
   EXPECT_FALSE(obs.settled());
+}
+
+TEST(Steering, AStandingWheelsNoisySpeedIsNotRolling) {
+  // The speed a standing wheel's gyro gives: white noise of 4 mm/s per sample (a real car's
+  // front wheel at idle, 120 Hz). Steered at rest for 10 s, the wheel does not start to
+  // roll: all its turn is steering.
+  SteeringObserver obs(kX, kRadius, SteeringOptions{});
+  obs.arm(0.0);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  const double dt = 1.0 / 120.0;
+  for (int k = 0; k < 1200; ++k) {
+    const auto st = obs.step(0.02, noise(rng), dt);
+    ASSERT_FALSE(st.rolling_began) << "epoch " << k;
+  }
+  EXPECT_NEAR(obs.angle(), 0.2, 1e-9);
 }

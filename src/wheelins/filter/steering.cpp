@@ -28,7 +28,8 @@ SteeringObserver::SteeringObserver(double distance_ahead, double wheel_radius, c
 SteeringObserver::Step SteeringObserver::step(double wheel_yaw_rate, double speed, double dt,
                                               double wheel_heading, double vehicle_heading) {
   Step out;
-  const bool rolling = std::abs(speed) > opt_.standstill_speed;
+  if (dt > 0.0) speed_lp_ += (speed - speed_lp_) * std::min(1.0, dt / opt_.standstill_time);
+  const bool rolling = std::abs(speed_lp_) > opt_.standstill_speed;
   const bool reference = vehicle_heading != kNoHeading;
   switch (phase_) {
     case Phase::kStanding:

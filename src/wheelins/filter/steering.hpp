@@ -54,7 +54,14 @@ struct SteeringOptions {
   /// Alone, from this distance rolled on, the turn so far sets delta_0 at every epoch until
   /// the onset's end measures it [m].
   double provisional_distance = 0.1;
-  double standstill_speed = 0.05;  ///< below it the wheel stands [m/s]
+  /// Below it the wheel stands [m/s], its speed low-passed over `standstill_time` [s]: a
+  /// car that creeps (an automatic at idle, a slow start) turns with the wheel, and a wheel
+  /// that creeps at a few cm/s with its steering held is not steered (0.04 m crept at 20 deg
+  /// would be 0.3 deg of the vehicle's heading, and the onset never gets it back). Its
+  /// speed from the gyro at rest: white noise of a few mm/s per sample, a tenth of that
+  /// low-passed.
+  double standstill_speed = 0.005;
+  double standstill_time = 0.1;
 };
 
 class SteeringObserver {
@@ -101,6 +108,7 @@ class SteeringObserver {
   SteeringOptions opt_;
   double onset_ = 0.5, reference_onset_ = 2.0;  // the onsets' distances: whole revolutions
   double delta_ = 0.0, rate_ = 0.0;
+  double speed_lp_ = 0.0;  // the speed low-passed over opt_.standstill_time
   Phase phase_ = Phase::kStanding;
   double turn_ = 0.0, distance_ = 0.0;  // over the onset: the wheel's turn, its signed travel
   // With a reference: the vehicle's heading at the onset's start and at the last epoch, and
