@@ -41,6 +41,10 @@ slow='FusionFaults\.(OutageOfTheFirstModuleIsBridgedAndItIsTakenBack|WheelSlipIs
 # updates, the slip's exact wheel rate, the simulator's jet derivatives, and two of the four
 # start-aligned evaluation checks.
 slow="$slow|FusionFaults\.SaturatedWheelGyroIsDetectedAndBridged|FilterMonteCarlo\.SpinningWheelImuWithVelocityUpdatesIsConsistent|SimFaults\.SlipChangesTheWheelRateExactly|SimPhysics\.JetDerivativesMatchCentralDifferences|StartAlignedEvaluation\.TurnedAndShiftedTrajectoryScoresLikeTheOriginal|StartAlignedEvaluation\.AlignmentSigmasDoNotDependOnTheTruthRate"
+# And (2026-12-06, the hand-in check at 42 min): the wheels' yaw scale factors from a
+# reference, 11 s in Release and 214 s under the sanitizers (the same fit runs here in
+# ReferenceCalibration.YawScaleFactorIsNotObservedOnAStraightDrive, 21 s).
+slow="$slow|ReferenceCalibration\.YawScaleFactorsOfTheWheelsAreFoundAndMakeTheHeadingHold"
 # One anchored group (CMake's regular expressions take ^ and $ only at the ends, and at most
 # nine groups: name further tests in full, not in a new group).
 left_out="${numeric_only%)\$}|$slow)\$"
