@@ -3,9 +3,11 @@
 over that of A on the same data (same condition and seed), per condition and over all:
 how many pairs are "no worse" (ratio <= --bound, default 1.05), the geometric mean of the
 ratios, the worst and the best. A or B may be min(X,Y,...): per data set the lowest drift of those
-configurations (e.g. "the best three-IMU configuration").
+configurations (e.g. "the best three-IMU configuration"). A:B+C:D pools the ratios of several
+pairs (e.g. each front wheel against the rear wheel on its side: two pairs per data set).
 
   scripts/paired-ratios.py RESULTS/jobs.csv rear:front 'min(rear-triple,front-triple):five'
+  scripts/paired-ratios.py RESULTS/jobs.csv rear:front+rear-right:front-right
 
 The figures of docs/accuracy.md's paired tables come from it. Jobs that are not done are
 left out and counted on standard error; a pair whose A or B is missing is left out."""
@@ -57,16 +59,23 @@ def side(spec, runs):
     return None if any(v is None for v in values) else min(values)
 
 
+def split_outside(text, sep):
+    """text split at each `sep` outside parentheses."""
+    depth, parts, start = 0, [], 0
+    for i, ch in enumerate(text):
+        depth += (ch == "(") - (ch == ")")
+        if ch == sep and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+    return parts + [text[start:]]
+
+
 def split_pair(pair):
     """A:B split at the colon outside parentheses; None unless there is exactly one."""
-    depth, cut = 0, []
-    for i, ch in enumerate(pair):
-        depth += (ch == "(") - (ch == ")")
-        if ch == ":" and depth == 0:
-            cut.append(i)
-    if len(cut) != 1 or cut[0] in (0, len(pair) - 1):
+    halves = split_outside(pair, ":")
+    if len(halves) != 2 or not all(halves):
         return None
-    return pair[:cut[0]], pair[cut[0] + 1:]
+    return halves[0], halves[1]
 
 
 def summary(ratios, bound):
@@ -81,7 +90,7 @@ def summary(ratios, bound):
 def main(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("jobs", help="a study's jobs.csv")
-    p.add_argument("pairs", nargs="+", help="A:B (B over A); A or B may be min(X,Y,...)")
+    p.add_argument("pairs", nargs="+", help="A:B (B over A); A or B may be min(X,Y,...); A:B+C:D pools pairs")
     p.add_argument("--bound", type=float, default=1.05, help="the largest ratio counted as no worse")
     a = p.parse_args(argv)
     try:
@@ -92,23 +101,25 @@ def main(argv):
     if skipped:
         print(f"{a.jobs}: {skipped} jobs not done, left out", file=sys.stderr)
     known = set(c for runs in data.values() for c in runs)
-    for pair in a.pairs:
-        halves = split_pair(pair)
-        if halves is None:
-            print(f"error: pair '{pair}' is not A:B", file=sys.stderr)
+    for pooled in a.pairs:
+        pairs = [split_pair(pair) for pair in split_outside(pooled, "+")]
+        if any(halves is None for halves in pairs):
+            print(f"error: pair '{pooled}' is not A:B (or A:B+C:D)", file=sys.stderr)
             return 2
-        first, second = halves
-        for n in configurations(first) + configurations(second):
-            if n not in known:
-                print(f"error: {a.jobs}: no configuration '{n}' (there are: {', '.join(sorted(known))})",
-                      file=sys.stderr)
-                return 2
+        for first, second in pairs:
+            for n in configurations(first) + configurations(second):
+                if n not in known:
+                    print(f"error: {a.jobs}: no configuration '{n}' (there are: {', '.join(sorted(known))})",
+                          file=sys.stderr)
+                    return 2
         by_condition = {}
         for (condition, *_), runs in sorted(data.items()):
-            lo, hi = side(first, runs), side(second, runs)
-            if lo is not None and hi is not None:
-                by_condition.setdefault(condition, []).append(hi / lo)
-        print(f"{second} against {first}: {summary([x for v in by_condition.values() for x in v], a.bound)}")
+            for first, second in pairs:
+                lo, hi = side(first, runs), side(second, runs)
+                if lo is not None and hi is not None:
+                    by_condition.setdefault(condition, []).append(hi / lo)
+        title = " with ".join(f"{second} against {first}" for first, second in pairs)
+        print(f"{title}: {summary([x for v in by_condition.values() for x in v], a.bound)}")
         for condition, ratios in by_condition.items():
             label = ", ".join(f"{ax} {v}" for ax, v in zip(axes, condition))
             print(f"  {label}: {summary(ratios, a.bound)}")

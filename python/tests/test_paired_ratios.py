@@ -40,6 +40,21 @@ def test_ratios_per_condition_and_the_best_of_several(tmp_path):
     assert "1 jobs not done" in p.stderr
 
 
+def test_pairs_pooled(tmp_path):
+    path = jobs(tmp_path, [
+        "field,0,1,a,done,0.2,1", "field,0,1,b,done,0.1,1", "field,0,1,c,done,0.4,1", "field,0,1,d,done,0.1,1",
+        "field,0,2,a,done,0.2,1", "field,0,2,b,done,0.8,1", "field,0,2,c,done,0.3,1",
+    ])
+    p = ratios(path, "a:b+c:d")
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.splitlines()
+    # b / a: 0.5 and 4.0; d / c: 0.25 (seed 2 has no d: that pair is left out)
+    assert lines[0] == "b against a with d against c: 2 of 3 no worse (67 %), geo-mean 0.79, worst 4.00, best 0.25"
+    assert lines[1] == "  profile field, terrain 0: 2 of 3 no worse (67 %), geo-mean 0.79, worst 4.00, best 0.25"
+    p = ratios(path, "a:b+c")
+    assert p.returncode == 2 and "'a:b+c' is not A:B" in p.stderr
+
+
 def test_bad_input_is_named(tmp_path):
     path = jobs(tmp_path, ["field,0,1,a,done,0.2,1", "field,0,1,b,done,nan,1"])
     p = ratios(path, "a:b")
