@@ -262,6 +262,23 @@ TEST(SimDataset, RobotRunFromSharedData) {
   EXPECT_EQ(snap.at("left-wheel-imu/tri_C1_imu.bin").size(), 12000u * 56u);
 }
 
+// An error setting out of range is named with the value as given, in the key's unit.
+TEST(SimDataset, ErrorSettingOutOfRangeIsNamedInItsUnit) {
+  SimConfig cfg;
+  cfg.apply_setting("errors.skid_deg_per_m_s2=-1");
+  try {
+    cfg.validate();
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("errors.skid_deg_per_m_s2: must be in [0, 1e+09], got -1"),
+              std::string::npos)
+        << e.what();
+  }
+  cfg.apply_setting("errors.skid_deg_per_m_s2=0.25");
+  EXPECT_NO_THROW(cfg.validate());
+  EXPECT_NEAR(cfg.errors.skid_angle, 0.25 * kDeg, 1e-15);
+}
+
 // Bad path and speed files are rejected with the file and the record named.
 TEST(SimDataset, BadInputNamesFileAndRecord) {
   const fs::path dir = temp_dir("bad");

@@ -284,6 +284,39 @@ TEST(SimPhysics, DefaultScenarioShape) {
   EXPECT_LT(min_radius, 3.0);
 }
 
+// errors.skid_deg_per_m_s2: the heading leaves the course by the slip angle k a_lat (a tyre's
+// law, a_lat = v^2 kappa); the path and the speed stay those of the scenario without it.
+TEST(SimPhysics, SkidAngleGrowsWithTheLateralAcceleration) {
+  DefaultScenarioOptions plain_opt;
+  plain_opt.speed = 6.0;
+  plain_opt.scale = 4.0;
+  DefaultScenarioOptions skid_opt = plain_opt;
+  const double k = 0.25 * kDeg;  // per m/s^2
+  skid_opt.skid_angle = k;
+  const PathScenario plain(default_scenario_spec(plain_opt)), skid(default_scenario_spec(skid_opt));
+  double largest = 0.0, largest_a_lat = 0.0;
+  int moving = 0;
+  for (double t = plain.static_end() + 1.0; t < plain.end_time(); t += 0.5) {
+    const VehicleState a = plain.state(t), b = skid.state(t);
+    ASSERT_LT((a.p_inN - b.p_inN).norm(), 1e-9) << t;
+    ASSERT_LT((a.v_inN - b.v_inN).norm(), 1e-9) << t;
+    const double v = a.v_inN.norm();
+    if (v < 0.5) continue;
+    ++moving;
+    const double course = std::atan2(a.v_inN.y(), a.v_inN.x());
+    EXPECT_NEAR(std::remainder(a.rpy().z() - course, 2.0 * kPi), 0.0, 1e-9) << t;
+    const double a_lat = v * v * plain.path_curvature(t).value();
+    const double beta = std::remainder(b.rpy().z() - course, 2.0 * kPi);
+    EXPECT_NEAR(beta, k * a_lat, 1e-9) << t;
+    largest = std::max(largest, std::abs(beta));
+    largest_a_lat = std::max(largest_a_lat, std::abs(a_lat));
+  }
+  EXPECT_GT(moving, 100);
+  EXPECT_GT(largest, 0.1 * kDeg);
+  std::printf("skid angle: up to %.3f deg (lateral acceleration up to %.2f m/s^2)\n", largest / kDeg,
+              largest_a_lat);
+}
+
 // A corrupt sample of a whole turn (2 pi) about the axle: the split's 1 / sinc(pi) would
 // blow the in-plane part up by 1e16; beyond 2 rad per sample the update is the two-sample
 // form's.

@@ -135,6 +135,7 @@ const ErrorKey kErrorKeys[] = {
     {"radius_rel", &ErrorParams::radius_rel, kSi},
     {"slip_per_m_s2", &ErrorParams::slip_coeff, kSi},
     {"skid_s", &ErrorParams::skid_coeff, kSi},
+    {"skid_deg_per_m_s2", &ErrorParams::skid_angle, kDegU},
     {"time_offset_s", &ErrorParams::time_offset, kSi},
     {"wheel_accel_noise_m_s_sqrt_h", &ErrorParams::wheel_accel_noise, kVrw},
     {"wheel_accel_noise_rest", &ErrorParams::wheel_accel_noise_rest, kSi},
@@ -452,15 +453,16 @@ void SimConfig::validate() const {
   if (start_time) check(*start_time, 0.0, 1e9, "start_time_s", "", "s");
   check(gps_week, 0.0, 1e5, "gps_week", "", "");
   for (const auto& k : kErrorKeys) {
-    const double x = errors.*k.member;
+    const double x = errors.*k.member * k.unit.div / k.unit.mul;  // in the key's unit, as given
     const std::string name = std::string("errors.") + k.key;
     // Full scales, time constants and the wheel's rolling noise factor need a positive value.
     const bool positive = name.find("range") != std::string::npos || name.find("tau") != std::string::npos;
-    check(x, 0.0, 1e9, name.c_str(), "", "(SI)", positive);
+    check(x, 0.0, 1e9, name.c_str(), "", "", positive);
   }
   for (const auto& k : kErrorVecKeys)
     for (int i = 0; i < 3; ++i)
-      check((errors.*k.member)[i], 0.0, 1e9, (std::string("errors.") + k.key).c_str(), "", "(SI)");
+      check((errors.*k.member)[i] * k.unit.div / k.unit.mul, 0.0, 1e9, (std::string("errors.") + k.key).c_str(), "",
+            "");
   for (const double* band : {errors.vib_body_band, errors.vib_wheel_band})
     if (!(band[0] > 0.0 && band[1] > band[0] && band[1] <= 1e5))
       throw InputError("simulator setting errors.vibration_*_band_hz: expected 0 < low < high, got [" +
@@ -567,7 +569,11 @@ std::string SimConfig::to_yaml() const {
     o << "    mounting_deg: " << vec_text(m->mounting_rpy, kDegU) << "\n";
   }
   o << "errors:\n";
-  for (const auto& ek : kErrorKeys) o << "  " << ek.key << ": " << human(errors.*ek.member, ek.unit) << "\n";
+  for (const auto& ek : kErrorKeys) {
+    // Written when set, so that the scenario.yaml of every earlier dataset stays the same.
+    if (ek.member == &ErrorParams::skid_angle && errors.skid_angle == 0.0) continue;
+    o << "  " << ek.key << ": " << human(errors.*ek.member, ek.unit) << "\n";
+  }
   for (const auto& ek : kErrorVecKeys) o << "  " << ek.key << ": " << vec_text(errors.*ek.member, ek.unit) << "\n";
   o << "  vibration_body_band_hz: [" << human(errors.vib_body_band[0], kSi) << ", "
     << human(errors.vib_body_band[1], kSi) << "]\n";

@@ -69,6 +69,9 @@ struct ErrorParams {
   double radius_rel = 0.002;  ///< effective rolling radius sigma, relative [-]
   double slip_coeff = 0.04;   ///< longitudinal slip per longitudinal acceleration [s^2/m]
   double skid_coeff = 0.06;   ///< lateral skid velocity per lateral acceleration [s]
+  /// The vehicle's slip angle per lateral acceleration [rad/(m/s^2)], a tyre's law (0: none,
+  /// every profile; with the `skid` effect, added to skid_coeff's).
+  double skid_angle = 0.0;
   // vibration (per-axis RMS in the v-frame: x, y, z); band [Hz]
   Vec3 vib_body_accel{0.2, 0.2, 0.4};         ///< [m/s^2]
   Vec3 vib_body_rate{0.8 * kDeg, 0.8 * kDeg, 0.4 * kDeg};   ///< [rad/s]

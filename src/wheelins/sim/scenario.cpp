@@ -250,13 +250,14 @@ void PathScenario::evaluate(double t, JV& p_inN, JM& C_VtoN) const {
   const J pn = comp(0, 0), pe = comp(0, 1);
   const J xn = comp(1, 0), xe = comp(1, 1);  // dp/du
   J heading = atan2(xe, xn);
-  if (spec_.skid_coeff != 0.0) {
+  if (spec_.skid_coeff != 0.0 || spec_.skid_angle != 0.0) {
     const J xnn = comp(2, 0), xee = comp(2, 1);  // d2p/du2
     const J m = sqrt(xn * xn + xe * xe);
     const J kappa = horizontal_curvature(xn, xe, xnn, xee);
     const J speed = m * udot;
-    // v_y = -skid * speed^2 * kappa  <=>  heading = course + atan(skid * speed * kappa)
-    heading += atan(spec_.skid_coeff * speed * kappa);
+    // v_y = -skid * speed^2 * kappa  <=>  heading = course + atan(skid * speed * kappa);
+    // a tyre's slip angle grows with the lateral acceleration: + skid_angle * speed^2 * kappa.
+    heading += atan(spec_.skid_coeff * speed * kappa) + spec_.skid_angle * speed * speed * kappa;
   }
   if (!spec_.terrain.enabled()) {
     p_inN = JV(pn, pe, J(0.0));
@@ -301,7 +302,7 @@ std::string PathScenario::describe() const {
   os << spec_.name << ": polyline " << path_.knots().size() << " vertices, "
      << polyline_length() << " m, corner sigma " << spec_.path_sigma << " m, speed sigma "
      << spec_.profile_sigma << " s" << (spec_.terrain.enabled() ? ", terrain" : "")
-     << (spec_.skid_coeff != 0.0 ? ", skid" : "");
+     << (spec_.skid_coeff != 0.0 || spec_.skid_angle != 0.0 ? ", skid" : "");
   return os.str();
 }
 
@@ -313,6 +314,7 @@ PathScenarioSpec default_scenario_spec(const DefaultScenarioOptions& opt) {
   s.path_sigma = opt.path_sigma;
   s.profile_sigma = opt.profile_sigma;
   s.skid_coeff = opt.skid_coeff;
+  s.skid_angle = opt.skid_angle;
   s.terrain = opt.terrain;
   // T-shaped block driven clockwise (north up, east right before rotation): a 45 m x 10 m
   // stem and a 70 m x 12 m bar; 254 m per lap, six right and two left 90-degree turns.
@@ -548,6 +550,7 @@ PathScenarioSpec path_file_scenario_spec(const std::filesystem::path& path_file,
   s.path_sigma = opt.path_sigma;
   s.profile_sigma = opt.profile_sigma;
   s.skid_coeff = opt.skid_coeff;
+  s.skid_angle = opt.skid_angle;
   s.terrain = opt.terrain;
   std::vector<std::array<double, 2>> ne;
   if (local) {

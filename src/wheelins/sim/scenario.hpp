@@ -90,6 +90,8 @@ struct PathScenarioSpec {
   /// Lateral skid: the velocity of o points outward of the turn by
   /// v_y = -skid_coeff * a_lat (a_lat = speed^2 * curvature). [s]
   double skid_coeff = 0.0;
+  /// ... and by the slip angle skid_angle * a_lat (a tyre's law) [rad/(m/s^2)].
+  double skid_angle = 0.0;
   Terrain terrain;
 };
 
@@ -130,6 +132,7 @@ struct DefaultScenarioOptions {
   double rotation_deg = 25.0;  ///< heading of the T's stem
   double scale = 1.0;          ///< size of the T (1: 254 m per lap)
   double skid_coeff = 0.0;
+  double skid_angle = 0.0;  ///< PathScenarioSpec::skid_angle
   Terrain terrain;
   /// A start with the wheels turned [1/m] (0: none): o starts at rest on an arc whose
   /// smoothed path has exactly this curvature at the start (positive: turning right), drives
@@ -152,6 +155,7 @@ struct PathFileOptions {
   bool fit_speed_to_path = true;  ///< scale the integrated speed to the polyline length
   std::optional<earth::Geodetic> origin;  ///< default: the first path point (height from file or 0)
   double skid_coeff = 0.0;
+  double skid_angle = 0.0;  ///< PathScenarioSpec::skid_angle
   Terrain terrain;
 };
 /// Reads a KML (<LineString> lon,lat[,h]) or CSV (lat,lon[,h] in degrees, or north,east

@@ -53,6 +53,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
   Terrain terrain;
   if (cfg_.terrain_slope_deg > 0.0) terrain = Terrain::gentle(cfg_.terrain_slope_deg, cfg_.seed);
   const double skid = cfg_.on("skid") ? cfg_.errors.skid_coeff : 0.0;
+  const double skid_angle = cfg_.on("skid") ? cfg_.errors.skid_angle : 0.0;
   if (cfg_.scenario == "default") {
     DefaultScenarioOptions o;
     if (cfg_.origin) o.origin = *cfg_.origin;
@@ -66,6 +67,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     o.stops = cfg_.stops;
     o.stop_duration = cfg_.stop_s;
     o.skid_coeff = skid;
+    o.skid_angle = skid_angle;
     o.terrain = terrain;
     // The front axle's centre (wheelbase, 0) turned by D: kappa = tan(D) / wheelbase.
     if (cfg_.start_steering_deg != 0.0)
@@ -82,6 +84,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     o.profile_sigma = cfg_.speed_sigma.value_or(cfg_.speed_file ? 0.5 : (car ? 2.5 : 1.2));
     o.origin = cfg_.origin;
     o.skid_coeff = skid;
+    o.skid_angle = skid_angle;
     o.terrain = terrain;
     scenario_ = std::make_unique<PathScenario>(path_file_scenario_spec(cfg_.scenario, o, &speed_scale_));
   }
