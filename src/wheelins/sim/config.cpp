@@ -110,6 +110,9 @@ struct ErrorKey {
   const char* key;
   double ErrorParams::*member;
   HumanUnit unit;
+  /// false: written to scenario.yaml only when not 0, so that the files of the datasets made
+  /// before the key existed stay the same.
+  bool always_written = true;
 };
 const ErrorKey kErrorKeys[] = {
     {"gyro_bias_deg_h", &ErrorParams::gyro_bias, kDegH},
@@ -135,7 +138,7 @@ const ErrorKey kErrorKeys[] = {
     {"radius_rel", &ErrorParams::radius_rel, kSi},
     {"slip_per_m_s2", &ErrorParams::slip_coeff, kSi},
     {"skid_s", &ErrorParams::skid_coeff, kSi},
-    {"skid_deg_per_m_s2", &ErrorParams::skid_angle, kDegU},
+    {"skid_deg_per_m_s2", &ErrorParams::skid_angle, kDegU, false},
     {"time_offset_s", &ErrorParams::time_offset, kSi},
     {"wheel_accel_noise_m_s_sqrt_h", &ErrorParams::wheel_accel_noise, kVrw},
     {"wheel_accel_noise_rest", &ErrorParams::wheel_accel_noise_rest, kSi},
@@ -570,8 +573,7 @@ std::string SimConfig::to_yaml() const {
   }
   o << "errors:\n";
   for (const auto& ek : kErrorKeys) {
-    // Written when set, so that the scenario.yaml of every earlier dataset stays the same.
-    if (ek.member == &ErrorParams::skid_angle && errors.skid_angle == 0.0) continue;
+    if (!ek.always_written && errors.*ek.member == 0.0) continue;
     o << "  " << ek.key << ": " << human(errors.*ek.member, ek.unit) << "\n";
   }
   for (const auto& ek : kErrorVecKeys) o << "  " << ek.key << ": " << vec_text(errors.*ek.member, ek.unit) << "\n";
