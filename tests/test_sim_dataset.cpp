@@ -279,6 +279,60 @@ TEST(SimDataset, ErrorSettingOutOfRangeIsNamedInItsUnit) {
   EXPECT_NEAR(cfg.errors.skid_angle, 0.25 * kDeg, 1e-15);
 }
 
+// draws_from: a module takes another module's draws (its radius, ..., and its chips' errors,
+// chip by chip), its chips' noise stays their own, every other module's draws are unchanged,
+// and scenario.yaml states the setting; names that are not the vehicle's modules are refused.
+TEST(SimDataset, DrawsFromAnotherModuleAreThatModulesDraws) {
+  SimConfig cfg = short_config();
+  cfg.vehicle = VehicleConfig::preset_named("car-steered");
+  cfg.chips = 1;
+  cfg.write_ideal = false;
+  const auto plain = simulate(cfg, "chips_own");
+  cfg.apply_setting("draws_from.front-left-wheel=left-wheel");
+  const auto copied = simulate(cfg, "chips_copied");
+  auto chip = [](const std::map<std::string, std::string>& snap, const char* group, const char* name) {
+    return YAML::Dump(YAML::Load(snap.at("errors.yaml"))["modules"][group]["chips"][name]);
+  };
+  EXPECT_EQ(chip(copied, "front-left-wheel", "front-left-C1"), chip(copied, "left-wheel", "left-C1"));
+  EXPECT_NE(chip(plain, "front-left-wheel", "front-left-C1"), chip(plain, "left-wheel", "left-C1"));
+  EXPECT_NE(chip(copied, "front-right-wheel", "front-right-C1"), chip(copied, "right-wheel", "right-C1"));
+  auto radius = [](const std::map<std::string, std::string>& snap, const char* group) {
+    return YAML::Load(snap.at("errors.yaml"))["modules"][group]["radius_true_m"].as<double>();
+  };
+  EXPECT_EQ(radius(copied, "front-left-wheel"), radius(copied, "left-wheel"));
+  EXPECT_NE(radius(plain, "front-left-wheel"), radius(plain, "left-wheel"));
+  EXPECT_NE(radius(copied, "front-right-wheel"), radius(copied, "right-wheel"));
+  for (const char* g : {"left-wheel", "right-wheel", "front-right-wheel"}) {
+    const std::string c = std::string(g).substr(0, std::string(g).size() - 6) + "-C1";
+    EXPECT_EQ(chip(copied, g, c.c_str()), chip(plain, g, c.c_str())) << g;
+  }
+  EXPECT_EQ(copied.at("left-wheel-imu/tri_C1_imu.bin"), plain.at("left-wheel-imu/tri_C1_imu.bin"));
+  EXPECT_NE(copied.at("front-left-wheel-imu/tri_C1_imu.bin"), plain.at("front-left-wheel-imu/tri_C1_imu.bin"));
+  EXPECT_EQ(plain.at("scenario.yaml").find("draws_from"), std::string::npos);
+  SimConfig again;
+  again.apply_yaml(YAML::Load(copied.at("scenario.yaml")), "scenario.yaml");
+  EXPECT_EQ(again.draws_from, cfg.draws_from);
+  EXPECT_EQ(again.to_yaml(), copied.at("scenario.yaml"));
+
+  auto refused = [&](const std::string& setting, const std::string& want) {
+    SimConfig bad = cfg;
+    bad.apply_setting(setting);
+    try {
+      bad.validate();
+      ADD_FAILURE() << setting << ": no InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
+  };
+  refused("draws_from.front-right-wheel=nowhere", "draws_from.front-right-wheel: 'nowhere' is not a module");
+  refused("draws_from.left-wheel=left-wheel", "draws_from.left-wheel: a module's draws are its own");
+  refused("draws_from.right-wheel=front-left-wheel", "'front-left-wheel' takes another module's draws");
+  refused("draws_from.body=left-wheel", "draws_from.body: 'left-wheel' is a wheel, 'body' is not");
+  SimConfig robot = short_config();
+  robot.apply_setting("draws_from.front-left-wheel=left-wheel");
+  EXPECT_THROW(robot.validate(), InputError);
+}
+
 // Bad path and speed files are rejected with the file and the record named.
 TEST(SimDataset, BadInputNamesFileAndRecord) {
   const fs::path dir = temp_dir("bad");

@@ -273,7 +273,7 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where, con
       "seed", "profile", "effects", "scenario", "speed_file", "duration_s", "rate_hz", "chips",
       "gps_week", "earth_rotation", "start_time_s", "origin", "static_s", "laps", "speed_m_s",
       "stops", "stop_s", "loop_scale", "path_sigma_m", "speed_sigma_s", "terrain_slope_deg", "start_steering_deg",
-      "vehicle", "errors", "faults"};
+      "vehicle", "errors", "faults", "draws_from"};
   auto key = [&](const std::string& k) { return where + ": " + k + (key_origin ? key_origin(k) : std::string()); };
   for (const auto& kv : node) {
     const auto k = get_text(kv.first, where + ": a key");
@@ -407,6 +407,17 @@ void SimConfig::apply_yaml(const YAML::Node& node, const std::string& where, con
         list.push_back(fault_from_yaml(f[i], key("faults[" + std::to_string(i) + "]")));
       faults = std::move(list);
     }
+    if (const auto& c = node["draws_from"]) {
+      // Entries are set one by one (null removes one, a null map clears them all), so that
+      // --set draws_from.GROUP=OTHER adds to a file's map.
+      if (c.IsNull()) draws_from.clear();
+      else if (!c.IsMap()) throw InputError(key("draws_from") + ": expected a map {module: module}");
+      for (const auto& kv : c) {
+        const std::string g = get_text(kv.first, key("draws_from"));
+        if (kv.second.IsNull()) draws_from.erase(g);
+        else draws_from[g] = get_text(kv.second, key("draws_from." + g));
+      }
+    }
   } catch (const YAML::Exception& ex) {
     throw InputError(where + ": " + ex.what());
   }
@@ -485,6 +496,7 @@ void SimConfig::validate() const {
                      " samples at rest; the initial alignment of `wheelins run` needs at least " +
                      std::to_string(kMinStaticSamples) + " (at least " +
                      human(kMinStaticSamples / rate_hz, kSi) + " s)");
+  check_draws_from();
   for (const ModuleGeometry* g : vehicle.modules()) {
     const double pos_room = ManifestLimits::kPositionM - 5.0 * errors.cal_position;
     const double arm_room = ManifestLimits::kWheelLeverArmM - 5.0 * errors.cal_lever_arm;
@@ -501,6 +513,35 @@ void SimConfig::validate() const {
                          human(ManifestLimits::kWheelLeverArmM, kSi) + " m per axis (" + human(arm_room, kSi) +
                          " m leaves room for errors.calibration_lever_arm_m)");
     }
+  }
+}
+
+void SimConfig::check_draws_from() const {
+  std::string groups;
+  for (const ModuleGeometry* g : vehicle.modules()) groups += (groups.empty() ? "" : ", ") + g->group;
+  auto find = [&](const std::string& n) -> const ModuleGeometry* {
+    for (const ModuleGeometry* g : vehicle.modules())
+      if (g->group == n) return g;
+    return nullptr;
+  };
+  for (const auto& [to, from] : draws_from) {
+    const std::string k = "simulator setting draws_from." + to + ": ";
+    if (!find(to))
+      throw InputError(k + "'" + to + "' is not a module of the vehicle preset '" + vehicle.preset + "' (" +
+                       groups + ")");
+    if (!find(from))
+      throw InputError(k + "'" + from + "' is not a module of the vehicle preset '" + vehicle.preset + "' (" +
+                       groups + ")");
+    if (from == to) throw InputError(k + "a module's draws are its own already");
+    if (find(from)->wheel != find(to)->wheel)
+      throw InputError(k + "'" + from + "' is " + (find(from)->wheel ? "a wheel" : "not a wheel") + ", '" + to +
+                       "' is " + (find(to)->wheel ? "one" : "not"));
+  }
+  for (const auto& [to, from] : draws_from) {
+    const std::string k = "simulator setting draws_from." + to + ": ";
+    if (draws_from.count(from))
+      throw InputError(k + "'" + from + "' takes another module's draws itself (" +
+                       draws_from.at(from) + "'s): name that module");
   }
 }
 
@@ -581,6 +622,10 @@ std::string SimConfig::to_yaml() const {
     << human(errors.vib_body_band[1], kSi) << "]\n";
   o << "  vibration_wheel_band_hz: [" << human(errors.vib_wheel_band[0], kSi) << ", "
     << human(errors.vib_wheel_band[1], kSi) << "]\n";
+  if (!draws_from.empty()) {
+    o << "draws_from:  # module: the module whose draws (its own and its chips' errors) it takes\n";
+    for (const auto& [to, from] : draws_from) o << "  " << to << ": " << from << "\n";
+  }
   // Times in seconds since the start of the data; the bias step in deg/s (gyro) or m/s^2.
   if (faults.empty()) {
     o << "faults: []\n";

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -163,6 +164,13 @@ struct SimConfig {
   /// Sensor-fault events (sim/faults.hpp), in the order given; times in seconds since the
   /// start of the data. The YAML key `faults` replaces the list; `--fault` appends to it.
   std::vector<FaultEvent> faults;
+  /// Module group -> the group whose random draws it takes: the module's own (true radius,
+  /// clock offset, temperature rise, vibration, calibration residuals) and its chips' error
+  /// parameters (biases, scale factors, misalignments, temperature coefficients), chip by
+  /// chip: the same wheel and chips in another place, for a comparison paired on them (key
+  /// `draws_from`; e.g. front-left-wheel: left-wheel). The white noise and the bias
+  /// processes stay the chips' own.
+  std::map<std::string, std::string> draws_from;
 
   bool on(const std::string& effect) const { return effects.count(effect) > 0; }
   /// Sets a profile: its parameters (field: gyro scale factor 3000 ppm) and its effects.
@@ -181,6 +189,9 @@ struct SimConfig {
   /// Every number in its range (docs/simulator.md); InputError naming the setting and its
   /// command-line option. The Simulation constructor calls it.
   void validate() const;
+  /// draws_from names modules of the vehicle of the same kind (wheel or body), none its own
+  /// and none a copy itself.
+  void check_draws_from() const;
   /// The complete settings as YAML text (the scenario.yaml format).
   std::string to_yaml() const;
 };

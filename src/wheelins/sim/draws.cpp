@@ -52,19 +52,20 @@ ModuleModel draw_module(const SimConfig& cfg, const std::string& gn, const Modul
   return m;
 }
 
-ChipModel draw_chip(const SimConfig& cfg, const std::string& name) {
+ChipModel draw_chip(const SimConfig& cfg, const std::string& name, const std::string& drawn_as) {
   const ErrorParams& e = cfg.errors;
   ChipModel ch;
   ch.name = name;
+  const std::string streams = drawn_as.empty() ? name : drawn_as;
   auto draw3 = [&](const std::string& stream, double sigma) {
-    Rng r(cfg.seed, ch.name + "/" + stream);
+    Rng r(cfg.seed, streams + "/" + stream);
     // The draws in a fixed order (z, y, x: the order the simulator's data were first made
     // in), not as a constructor's arguments, whose order of evaluation the compiler chooses.
     const double z = r.normal(sigma), y = r.normal(sigma), x = r.normal(sigma);
     return Vec3(x, y, z);
   };
   auto draw_T = [&](const std::string& stream, double sf, double mis, bool sf_on, bool mis_on) {
-    Rng r(cfg.seed, ch.name + "/" + stream);
+    Rng r(cfg.seed, streams + "/" + stream);
     Mat3 T = Mat3::Identity();
     for (int i = 0; i < 3; ++i) {
       const double s = r.normal(sf);

@@ -12,11 +12,14 @@ namespace wheelins::sim {
 
 /// Module `group` ("left-wheel", ...) with the given geometry: the truth, the manifest's
 /// geometry, and the physical effects enabled in `cfg`; `cruise`: the scenario's cruise
-/// speed (the vibration gain's reference) [m/s].
-ModuleModel draw_module(const SimConfig& cfg, const std::string& group, const ModuleGeometry& geo,
+/// speed (the vibration gain's reference) [m/s]; its draws from the streams of module
+/// `drawn_as` (SimConfig::draws_from).
+ModuleModel draw_module(const SimConfig& cfg, const std::string& drawn_as, const ModuleGeometry& geo,
                         double cruise);
 
-/// Chip `name` ("left-C1", ...) with the error effects enabled in `cfg`.
-ChipModel draw_chip(const SimConfig& cfg, const std::string& name);
+/// Chip `name` ("left-C1", ...) with the error effects enabled in `cfg`, its parameters drawn
+/// from the streams of chip `drawn_as` (default: its own name; another chip's name gives a
+/// chip with that chip's errors, SimConfig::draws_from).
+ChipModel draw_chip(const SimConfig& cfg, const std::string& name, const std::string& drawn_as = {});
 
 }  // namespace wheelins::sim

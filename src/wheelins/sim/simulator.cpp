@@ -106,9 +106,16 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
     if (geo[g]->group != group_name(g))
       throw InputError(std::string("simulate: module ") + std::to_string(g) + " is '" + geo[g]->group +
                        "', expected '" + group_name(g) + "'");
-    modules_[g] = draw_module(cfg_, group_name(g), *geo[g], cruise);
-    for (int c = 1; c <= cfg_.chips; ++c)
-      chips_[g].push_back(draw_chip(cfg_, chip_prefix(g) + std::string("-C") + std::to_string(c)));
+    const auto copy = cfg_.draws_from.find(group_name(g));
+    int drawn_as = g;
+    if (copy != cfg_.draws_from.end())
+      for (int o = 0; o < groups(); ++o)
+        if (copy->second == group_name(o)) drawn_as = o;
+    modules_[g] = draw_module(cfg_, group_name(drawn_as), *geo[g], cruise);
+    for (int c = 1; c <= cfg_.chips; ++c) {
+      const std::string n = "-C" + std::to_string(c);
+      chips_[g].push_back(draw_chip(cfg_, chip_prefix(g) + n, chip_prefix(drawn_as) + n));
+    }
   }
 
   // Fault events: the targets must exist and the start must lie within the data. They use no
