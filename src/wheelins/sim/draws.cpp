@@ -4,7 +4,7 @@
 
 namespace wheelins::sim {
 
-ModuleModel draw_module(const SimConfig& cfg, const std::string& gn, const ModuleGeometry& geo,
+ModuleModel draw_module(const SimConfig& cfg, const std::string& drawn_as, const ModuleGeometry& geo,
                         double cruise) {
   const ErrorParams& e = cfg.errors;
   ModuleModel m;
@@ -13,30 +13,30 @@ ModuleModel draw_module(const SimConfig& cfg, const std::string& gn, const Modul
   const bool wheel = m.truth.wheel;
   m.radius = m.radius_manifest = wheel ? cfg.vehicle.wheel_radius : 0.0;
   {
-    Rng r(cfg.seed, gn + "/radius");
+    Rng r(cfg.seed, drawn_as + "/radius");
     const double d = r.normal(e.radius_rel);
     if (wheel && cfg.on("radius")) m.radius = cfg.vehicle.wheel_radius * (1.0 + d);
   }
   if (wheel && cfg.on("slip")) m.slip_coeff = e.slip_coeff;
   {
-    Rng r(cfg.seed, gn + "/time_offset");
+    Rng r(cfg.seed, drawn_as + "/time_offset");
     const double d = r.normal(e.time_offset);
     if (cfg.on("time_offset")) m.time_offset = d;
   }
   {
-    Rng r(cfg.seed, gn + "/temperature");
+    Rng r(cfg.seed, drawn_as + "/temperature");
     const double d = e.temp_rise * (1.0 + 0.2 * r.normal());
     if (cfg.on("temperature")) m.temp_rise = d;
   }
   {
-    Rng r(cfg.seed, gn + "/vibration");
+    Rng r(cfg.seed, drawn_as + "/vibration");
     Vibration v = wheel ? Vibration::draw(r, e.vib_wheel_accel, e.vib_wheel_rate, e.vib_wheel_band)
                         : Vibration::draw(r, e.vib_body_accel, e.vib_body_rate, e.vib_body_band);
     if (cfg.on("vibration")) m.vibration = std::move(v);
     m.vib_cruise_speed = cruise;
   }
   {
-    Rng r(cfg.seed, gn + "/calibration");
+    Rng r(cfg.seed, drawn_as + "/calibration");
     Vec3 dl, dm, dp;
     for (int i = 0; i < 3; ++i) dl[i] = r.normal(e.cal_lever_arm);
     for (int i = 0; i < 3; ++i) dm[i] = r.normal(e.cal_mounting);

@@ -10,10 +10,10 @@
 
 namespace wheelins::sim {
 
-/// Module `group` ("left-wheel", ...) with the given geometry: the truth, the manifest's
-/// geometry, and the physical effects enabled in `cfg`; `cruise`: the scenario's cruise
-/// speed (the vibration gain's reference) [m/s]; its draws from the streams of module
-/// `drawn_as` (SimConfig::draws_from).
+/// A module with geometry `geo`: the truth, the manifest's geometry, and the physical effects
+/// enabled in `cfg`, drawn from the streams of module `drawn_as` ("left-wheel", ...: its own
+/// group, or the one SimConfig::draws_from names); `cruise`: the scenario's cruise speed (the
+/// vibration gain's reference) [m/s].
 ModuleModel draw_module(const SimConfig& cfg, const std::string& drawn_as, const ModuleGeometry& geo,
                         double cruise);
 

@@ -107,10 +107,7 @@ Simulation::Simulation(const SimConfig& cfg) : cfg_(cfg) {
       throw InputError(std::string("simulate: module ") + std::to_string(g) + " is '" + geo[g]->group +
                        "', expected '" + group_name(g) + "'");
     const auto copy = cfg_.draws_from.find(group_name(g));
-    int drawn_as = g;
-    if (copy != cfg_.draws_from.end())
-      for (int o = 0; o < groups(); ++o)
-        if (copy->second == group_name(o)) drawn_as = o;
+    const int drawn_as = copy == cfg_.draws_from.end() ? g : group_index(copy->second);  // validated
     modules_[g] = draw_module(cfg_, group_name(drawn_as), *geo[g], cruise);
     for (int c = 1; c <= cfg_.chips; ++c) {
       const std::string n = "-C" + std::to_string(c);
