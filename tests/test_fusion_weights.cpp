@@ -5,6 +5,7 @@
 // (a poor chip counts less) is FusionFaults.APoorChipCountsLessWithWeightsFromTheCovariance.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -178,25 +179,49 @@ TEST(ReferenceWeights, RunConfigurationChoosesTheWeighting) {
 TEST(StandaloneDrift, LateralVarianceMatchesTheClosedForms) {
   const double v = 5.0, arw = 0.3 * kDeg / 60.0, T = 600.0;
   StandaloneDrift a;
-  a.start(0.0, 0.0);
-  for (int k = 1; k <= 600; ++k) a.step(k * 1.0, v, arw, 0.0, 3600.0);
+  a.start(0.0, 0.0, 0.0, 0.0);
+  for (int k = 1; k <= 600; ++k) a.step(k * 1.0, 0.0, v, arw, 0.0, 3600.0);
   EXPECT_NEAR(a.lateral_variance() / (v * v * arw * arw * T * T * T / 3.0), 1.0, 2e-3);
   StandaloneDrift b;
   const double s = 10.0 * kDeg / 3600.0;
-  b.start(0.0, s * s);
-  b.step(T, v, 0.0, 0.0, 3600.0);  // one call, split into 1 s steps inside
+  b.start(0.0, 0.0, s * s, 0.0);
+  b.step(T, 0.0, v, 0.0, 0.0, 3600.0);  // one call, split into 1 s steps inside
   EXPECT_NEAR(b.lateral_variance() / (v * v * s * s * T * T * T * T / 4.0), 1.0, 2e-3);
   EXPECT_DOUBLE_EQ(b.t, T);
   // A bias that wanders (Gauss-Markov of sigma s, from zero) drifts, less than one of that
   // sigma held from the start; standing still adds nothing.
   StandaloneDrift c;
-  c.start(0.0, 0.0);
-  c.step(T, v, 0.0, s, 3600.0);
+  c.start(0.0, 0.0, 0.0, 0.0);
+  c.step(T, 0.0, v, 0.0, s, 3600.0);
   EXPECT_GT(c.lateral_variance(), 0.01 * b.lateral_variance());
   EXPECT_LT(c.lateral_variance(), b.lateral_variance());
   const double before = c.lateral_variance();
-  c.step(T + 100.0, 0.0, arw, s, 3600.0);
+  c.step(T + 100.0, 0.0, 0.0, arw, s, 3600.0);
   EXPECT_DOUBLE_EQ(c.lateral_variance(), before);
+}
+
+// A yaw-rate scale factor s puts s times the turned angle into the heading: driving at v on
+// a circle at yaw rate omega from the start, psi = s omega t, so var(e) = v^2 omega^2 sf2
+// t^4 / 4, and the same whether the heading comes in steps of 1 s or at once; driving
+// straight it adds nothing, and turning back undoes the heading error it made.
+TEST(StandaloneDrift, AScaleFactorDriftsWithTheTurnedAngle) {
+  const double v = 5.0, omega = 0.1, sf = 3000e-6, T = 60.0;
+  StandaloneDrift a;
+  a.start(0.0, 0.0, 0.0, sf * sf);
+  for (int k = 1; k <= 60; ++k) a.step(k * 1.0, std::remainder(omega * k, 2.0 * kPi), v, 0.0, 0.0, 3600.0);
+  EXPECT_NEAR(a.lateral_variance() / (v * v * omega * omega * sf * sf * T * T * T * T / 4.0), 1.0, 2e-3);
+  EXPECT_NEAR(a.P(1, 1) / std::pow(sf * omega * T, 2), 1.0, 1e-9);
+  StandaloneDrift straight;
+  straight.start(0.0, 1.0, 0.0, sf * sf);
+  straight.step(T, 1.0, v, 0.0, 0.0, 3600.0);
+  EXPECT_DOUBLE_EQ(straight.lateral_variance(), 0.0);
+  StandaloneDrift back;  // a left turn of 0.5 rad, then back to the start's heading
+  back.start(0.0, 0.0, 0.0, sf * sf);
+  back.step(5.0, 0.5, v, 0.0, 0.0, 3600.0);
+  EXPECT_GT(back.P(1, 1), 0.0);
+  back.step(10.0, 0.0, v, 0.0, 0.0, 3600.0);
+  EXPECT_NEAR(back.P(1, 1), 0.0, 1e-18);
+  EXPECT_GT(back.lateral_variance(), 0.0);
 }
 
 // A Body-IMU's unmodulated yaw bias makes its drift on its own grow faster than a Wheel-IMU's
@@ -212,9 +237,9 @@ TEST(StandaloneDrift, TheBodyImuCountsLessTheLongerItDrivesOnItsOwn) {
   const double bias_var0 = std::pow(3.0 * kDeg / 3600.0, 2);
   double body_share_early = 0.0;
   for (int k = 1; k <= 900; ++k) {
-    w.observe_standalone(0, k, 5.0, q, true, 0.0);
-    w.observe_standalone(1, k, 5.0, q, true, 0.0);
-    w.observe_standalone(2, k, 5.0, q, false, bias_var0);
+    w.observe_standalone(0, k, 0.0, 5.0, q, true, 0.0, 0.0);
+    w.observe_standalone(1, k, 0.0, 5.0, q, true, 0.0, 0.0);
+    w.observe_standalone(2, k, 0.0, 5.0, q, false, bias_var0, 0.0);
     if (k == 30) body_share_early = w.weight(2) / (w.weight(0) + w.weight(1) + w.weight(2));
   }
   const double body_share = w.weight(2) / (w.weight(0) + w.weight(1) + w.weight(2));

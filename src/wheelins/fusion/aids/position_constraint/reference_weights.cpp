@@ -2,6 +2,7 @@
 #include "wheelins/fusion/aids/position_constraint/reference_weights.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace wheelins {
@@ -11,31 +12,40 @@ double reference_point_variance(const ReferencePointModel& r, const Mat21& P) {
   return (Hh * P * Hh.transpose()).trace();
 }
 
-void StandaloneDrift::start(double t0, double bias_var) {
+void StandaloneDrift::start(double t0, double heading0, double bias_var, double sf_var) {
   P.setZero();
   P(2, 2) = std::max(bias_var, 0.0);
+  P(3, 3) = std::max(sf_var, 0.0);
   t = t0;
+  heading = heading0;
   started = true;
 }
 
-void StandaloneDrift::step(double t1, double speed, double arw, double bias_std, double tau) {
+void StandaloneDrift::step(double t1, double heading1, double speed, double arw, double bias_std,
+                           double tau) {
   // Phi = exp(A dt) and Q_d = int Phi Q_c Phi^T to second order in dt (A^3 = 0 but for the
-  // bias decay, which over 1 s of a correlation time of minutes is first order).
+  // bias decay, which over 1 s of a correlation time of minutes is first order). The yaw
+  // rate is the mean over the whole interval.
   const double beta = bias_std > 0.0 && tau > 0.0 ? 1.0 / tau : 0.0;
   const double qb = bias_std > 0.0 && tau > 0.0 ? 2.0 * bias_std * bias_std / tau : 0.0;
+  const double omega = t1 - t > 1e-9 ? std::remainder(heading1 - heading, 2.0 * kPi) / (t1 - t) : 0.0;
   while (t1 - t > 1e-9) {
     const double dt = std::min(1.0, t1 - t);
-    Eigen::Matrix3d A;
-    A << 0.0, speed, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -beta;
-    const Eigen::Matrix3d Phi = Eigen::Matrix3d::Identity() + A * dt + A * A * (0.5 * dt * dt);
-    const Eigen::Vector3d qc(0.0, arw * arw, qb);
-    const Eigen::Matrix3d Qc = qc.asDiagonal();
-    const Eigen::Matrix3d AQ = A * Qc;
-    const Eigen::Matrix3d Qd = Qc * dt + (AQ + AQ.transpose()) * (0.5 * dt * dt) +
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    A(0, 1) = speed;
+    A(1, 2) = 1.0;
+    A(1, 3) = omega;
+    A(2, 2) = -beta;
+    const Eigen::Matrix4d Phi = Eigen::Matrix4d::Identity() + A * dt + A * A * (0.5 * dt * dt);
+    const Eigen::Vector4d qc(0.0, arw * arw, qb, 0.0);
+    const Eigen::Matrix4d Qc = qc.asDiagonal();
+    const Eigen::Matrix4d AQ = A * Qc;
+    const Eigen::Matrix4d Qd = Qc * dt + (AQ + AQ.transpose()) * (0.5 * dt * dt) +
                                A * Qc * A.transpose() * (dt * dt * dt / 3.0);
     P = Phi * P * Phi.transpose() + Qd;
     t += dt;
   }
+  heading = heading1;
 }
 
 ReferenceWeights::ReferenceWeights(const FusionOptions& options, const std::vector<double>& configured)
@@ -46,11 +56,11 @@ ReferenceWeights::ReferenceWeights(const FusionOptions& options, const std::vect
   for (int i = 0; i < n_; ++i) w_[i] = covariance_ || standalone_ ? 1.0 : configured[i];
 }
 
-void ReferenceWeights::observe_standalone(int i, double t, double speed, const ImuNoise& q, bool wheel,
-                                          double bias_var0) {
+void ReferenceWeights::observe_standalone(int i, double t, double heading, double speed, const ImuNoise& q,
+                                          bool wheel, double bias_var0, double sf_var0) {
   StandaloneDrift& d = drift_[i];
-  if (!d.started) d.start(t, wheel ? 0.0 : bias_var0);
-  d.step(t, speed, q.gyro_arw, wheel ? 0.0 : q.gyro_bias_std, q.gyro_bias_tau);
+  if (!d.started) d.start(t, heading, wheel ? 0.0 : bias_var0, sf_var0);
+  d.step(t, heading, speed, q.gyro_arw, wheel ? 0.0 : q.gyro_bias_std, q.gyro_bias_tau);
   w_[i] = 1.0 / std::max(d.lateral_variance(), kMinVariance);
 }
 

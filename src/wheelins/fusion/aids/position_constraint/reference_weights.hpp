@@ -43,26 +43,32 @@ double reference_point_variance(const ReferencePointModel& r, const Mat21& P);
 
 /// A subsystem's lateral drift without the position constraint, for the weights of
 /// ReferenceWeighting::kStandalone: the covariance of [lateral position e (m), heading psi
-/// (rad), vertical gyro bias b (rad/s)] under
-///   e' = v psi,   psi' = b + w_arw,   b' = -b / tau + w_b   (first-order Gauss-Markov),
-/// the heading error that no measurement of a subsystem's own observes (wheel speed and the
-/// non-holonomic constraints see velocity in its own frame, not heading). A Body-IMU's
-/// vertical gyro bias enters as it is (its variance at the start, then its instability); a
-/// Wheel-IMU's gyro turns with the wheel, which modulates the bias of its two axes in the
-/// wheel plane to a zero mean (the paper's rotation modulation), so its heading grows with
-/// the angle random walk alone. The common initial heading error is left out: it moves
-/// every subsystem alike and so no weight.
+/// (rad), vertical gyro bias b (rad/s), yaw-rate scale factor s (-)] under
+///   e' = v psi,   psi' = b + omega s + w_arw,   b' = -b / tau + w_b,   s' = 0
+/// (omega the vehicle's yaw rate; b a first-order Gauss-Markov process), the heading error
+/// that no measurement of a subsystem's own observes (wheel speed and the non-holonomic
+/// constraints see velocity in its own frame, not heading). A Body-IMU's vertical gyro bias
+/// enters as it is (its variance at the start, then its instability); a Wheel-IMU's gyro
+/// turns with the wheel, which modulates the bias of its two axes in the wheel plane to a
+/// zero mean (the paper's rotation modulation), so its heading grows with the angle random
+/// walk and its scale factor, which the rotation does not cancel: the mean of those two
+/// axes' scale factors is its yaw-rate scale factor, and every turn the vehicle makes puts
+/// s times the turned angle into the heading, for a Wheel-IMU as for a Body-IMU. The
+/// common initial heading error is left out: it moves every subsystem alike and so no weight.
 struct StandaloneDrift {
-  Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
+  Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
   double t = 0.0;
+  double heading = 0.0;  ///< the vehicle's heading at t [rad], for omega
   bool started = false;
 
-  /// Starts at time t with the vertical bias variance `bias_var` [rad^2/s^2] (0: modulated).
-  void start(double t0, double bias_var);
-  /// Propagates to time t1 at ground speed `speed` [m/s]: angle random walk `arw`
-  /// [rad/sqrt(s)]; the bias a Gauss-Markov process of sigma `bias_std` [rad/s] and
+  /// Starts at time t0 and vehicle heading `heading0` with the vertical bias variance
+  /// `bias_var` [rad^2/s^2] (0: modulated) and the yaw-rate scale factor's `sf_var`.
+  void start(double t0, double heading0, double bias_var, double sf_var);
+  /// Propagates to time t1 and vehicle heading `heading1` (the yaw rate between is the
+  /// heading's change over the time, wrapped) at ground speed `speed` [m/s]: angle random walk
+  /// `arw` [rad/sqrt(s)]; the bias a Gauss-Markov process of sigma `bias_std` [rad/s] and
   /// correlation time `tau` [s] (bias_std 0: no bias, a Wheel-IMU). Steps of at most 1 s.
-  void step(double t1, double speed, double arw, double bias_std, double tau);
+  void step(double t1, double heading1, double speed, double arw, double bias_std, double tau);
   double lateral_variance() const { return P(0, 0); }
 };
 
@@ -78,12 +84,13 @@ class ReferenceWeights {
   bool from_standalone() const { return standalone_; }
   /// Subsystem i's o variance at this constraint epoch; `counted`: it is in the mean now.
   void observe(int i, double variance, bool counted);
-  /// kStandalone: subsystem i's constraint-free drift at time t (its own noise model `q`;
-  /// `bias_var0` the variance of its vertical gyro bias when it first counts, 0 for a
-  /// Wheel-IMU). Its weight is the inverse of its lateral variance; it keeps growing
-  /// through an outage (the drift of a subsystem left to itself).
-  void observe_standalone(int i, double t, double speed, const ImuNoise& q, bool wheel,
-                          double bias_var0);
+  /// kStandalone: subsystem i's constraint-free drift at time t and vehicle heading
+  /// `heading` (its own noise model `q`; `bias_var0` the variance of its vertical gyro bias
+  /// when it first counts, 0 for a Wheel-IMU; `sf_var0` its yaw-rate scale factor's). Its
+  /// weight is the inverse of its lateral variance; it keeps growing through an outage (the
+  /// drift of a subsystem left to itself).
+  void observe_standalone(int i, double t, double heading, double speed, const ImuNoise& q, bool wheel,
+                          double bias_var0, double sf_var0);
   const StandaloneDrift& drift(int i) const { return drift_[i]; }
   /// Subsystem i's relative weight now (> 0; not normalised).
   double weight(int i) const { return w_[i]; }
