@@ -70,6 +70,44 @@ TEST(NoiseIdentification, WhiteNoiseDensityAndABoundOnTheBiasInstabilityFrom30s)
   EXPECT_NEAR(e.bias_instability, arw / std::sqrt(e.bias_tau) / 0.664, 0.35 * e.bias_instability);
 }
 
+TEST(NoiseIdentification, AVibrationDoesNotReadAsAngleRandomWalk) {
+  // The real car standing with its engine running: 14 s at 120 Hz, a 22.4 Hz vibration of
+  // 0.05 rad/s on every axis over a white noise of 0.5 deg/sqrt(h). At the sample interval
+  // the vibration reads as an angle random walk of several deg/sqrt(h); it does not
+  // integrate into an angle, and the white noise is read where it has averaged out.
+  const double arw = 0.5 * kDeg / 60.0, dt = 1.0 / 120.0, f = 22.4, amp = 0.05;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  AllanAccumulator a;
+  for (int k = 0; k < 1680; ++k) {
+    Vec3 y;
+    for (int i = 0; i < 3; ++i)
+      y[i] = amp * std::sin(2.0 * kPi * f * k * dt + i) + arw / std::sqrt(dt) * n01(rng);
+    a.add(y, dt);
+  }
+  const SensorNoiseEstimate e = estimate_sensor_noise(a);
+  ASSERT_TRUE(e.valid);
+  EXPECT_GT(std::sqrt(a.variance(0).mean() * a.tau(0)), 3.0 * arw);  // what tau0 would give
+  EXPECT_NEAR(e.white, arw, 0.2 * arw);
+  EXPECT_GT(e.white_tau, 0.1);
+  EXPECT_LE(e.white_tau, kWhiteTauMax);
+}
+
+TEST(NoiseIdentification, WhiteNoiseIsReadAtTheSampleIntervalWhenNothingElseIsThere) {
+  // Pure white noise: every level agrees within its scatter and the shortest, the most
+  // certain, is taken (over 20 records, none of them read at a longer cluster time).
+  const double n = 0.004, dt = 0.005;
+  std::normal_distribution<double> n01(0.0, 1.0);
+  for (int seed = 0; seed < 20; ++seed) {
+    std::mt19937_64 rng(100 + seed);
+    AllanAccumulator a;
+    for (int k = 0; k < 4000; ++k) a.add(Vec3(n01(rng), n01(rng), n01(rng)) * (n / std::sqrt(dt)), dt);
+    const SensorNoiseEstimate e = estimate_sensor_noise(a);
+    EXPECT_NEAR(e.white_tau, dt, 1e-9) << "seed " << seed;
+    EXPECT_NEAR(e.white, n, 0.05 * n) << "seed " << seed;
+  }
+}
+
 TEST(NoiseIdentification, BiasInstabilityFloorIsFoundWhenTheRecordIsLongEnough) {
   // White noise N plus a rate random walk K: sigma_A^2 = N^2 / tau + K^2 tau / 3, whose
   // minimum lies at tau* = sqrt(3) N / K (here 1 s) inside the 200 s record.

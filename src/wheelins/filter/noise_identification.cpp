@@ -43,10 +43,33 @@ SensorNoiseEstimate estimate_sensor_noise(const AllanAccumulator& a) {
   if (a.samples() < 200) return e;
   e.valid = true;
   e.duration = a.mean_dt() * static_cast<double>(a.samples());
-  const double tau0 = a.tau(0);
-  const Vec3 v0 = a.variance(0);
-  e.white_axes = (v0 * tau0).cwiseSqrt();
-  e.white = std::sqrt(v0.mean() * tau0);
+  // The white noise: on its line sigma_A^2 tau is the same at every tau, while a vibration
+  // (the engine's 22 Hz on the real car, standing with it running) falls as tau^-2 and
+  // reads at the sample interval as an angle random walk several times the chip's, which
+  // does not integrate into the heading; a bias instability or random walk rises. So the
+  // shortest cluster time whose sigma_A^2 tau no longer one is below by more than 3 of
+  // their scatters (1 / sqrt(M) relative for M differences).
+  const auto usable = [&](int l) {
+    return l == 0 || (a.differences(l) >= kWhiteMinDifferences && a.tau(l) <= kWhiteTauMax);
+  };
+  const auto density = [&](int l) { return a.variance(l).mean() * a.tau(l); };
+  const auto inv_m = [&](int l) { return 1.0 / static_cast<double>(std::max<std::uint64_t>(a.differences(l), 1)); };
+  int wl = 0;
+  for (int l = 0; l < AllanAccumulator::kLevels; ++l) {
+    if (!usable(l)) continue;
+    bool below = false;
+    for (int j = l + 1; j < AllanAccumulator::kLevels && !below; ++j)
+      below = usable(j) && density(j) < density(l) * (1.0 - 3.0 * std::sqrt(inv_m(l) + inv_m(j)));
+    if (!below) {
+      wl = l;
+      break;
+    }
+  }
+  const double tw = a.tau(wl);
+  const Vec3 vw = a.variance(wl);
+  e.white_axes = (vw * tw).cwiseSqrt();
+  e.white = std::sqrt(vw.mean() * tw);
+  e.white_tau = tw;
   // Bias instability: the minimum of sigma_A (RMS over the axes) over the levels with at
   // least 8 differences; at the last such level the floor is not known to be reached.
   int last = 0;

@@ -2,12 +2,12 @@
 //
 // At rest: the Allan variance of each sensor's rate samples over the static period
 // (IEEE Std 952-1997, annex C; El-Sheimy, Hou, Niu 2008), at octave cluster times
-// tau = 2^L dt, accumulated sample by sample in O(levels) memory. Its value at the
-// sample interval gives the white-noise density (ARW for a gyro, VRW for an
-// accelerometer: N^2 = sigma_A^2(tau0) tau0, which also takes in the quantization
-// of rate samples), and its minimum the bias instability B = min sigma_A / 0.664 —
-// or only a bound on it when the curve still falls as tau^-1/2 at the longest
-// cluster time the period allows (a 30 s period cannot show a MEMS gyro's floor).
+// tau = 2^L dt, accumulated sample by sample in O(levels) memory. The white-noise density
+// (ARW for a gyro, VRW for an accelerometer) N^2 = sigma_A^2(tau) tau, the same at every
+// tau on the white-noise line, is read at the shortest tau up to 1 s that no longer one
+// undercuts (a vibration averages out); the curve's minimum gives the bias instability
+// B = min sigma_A / 0.664, or only a bound on it when the curve still falls as tau^-1/2 at
+// the longest cluster time the period allows (a 30 s period cannot show a MEMS gyro's floor).
 //
 // In motion: the innovations of a velocity update, by Mehra's (1970) correlation
 // method (VelocityNoiseMatcher): their variance alone cannot tell measurement noise
@@ -69,6 +69,7 @@ struct SensorNoiseEstimate {
   bool valid = false;          ///< enough samples (>= 200)
   double white = 0.0;          ///< white-noise density, RMS over the axes [unit/sqrt(s)]
   Vec3 white_axes = Vec3::Zero();
+  double white_tau = 0.0;      ///< the cluster time it was read at [s]
   /// Bias instability [unit]: min over tau of sigma_A / 0.664 (RMS over the axes) ...
   double bias_instability = 0.0;
   /// ... at this cluster time [s]; when the minimum lies at the longest usable tau the
@@ -78,8 +79,16 @@ struct SensorNoiseEstimate {
   double duration = 0.0;       ///< [s]
 };
 
-/// Reads an AllanAccumulator: the white noise from the shortest cluster time, the
-/// bias instability from the minimum over the levels with at least 8 differences.
+/// The white noise is read at cluster times up to this [s] ...
+inline constexpr double kWhiteTauMax = 1.0;
+/// ... with at least this many differences.
+inline constexpr std::uint64_t kWhiteMinDifferences = 20;
+
+/// Reads an AllanAccumulator: the white noise N^2 = sigma_A^2(tau) tau at the shortest
+/// cluster time (up to kWhiteTauMax, kWhiteMinDifferences differences) that no longer one
+/// undercuts by more than 3 of their scatters: the white-noise line where a vibration has
+/// averaged out and before a bias instability rises; the bias instability from the minimum
+/// of sigma_A over the levels with at least 8 differences.
 SensorNoiseEstimate estimate_sensor_noise(const AllanAccumulator& a);
 
 /// Noise identification from the innovations of one velocity measurement (3 axes: axis 0

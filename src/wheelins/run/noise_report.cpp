@@ -60,9 +60,9 @@ void at_rest_section(std::ostringstream& o, const ModuleNoiseReport& r) {
   if (r.gyro_rest.valid) {
     o << "    at_rest:  # " << num(r.gyro_rest.duration, 4) << " s of static data\n";
     o << "      gyro_arw_deg_sqrt_h: " << num(arw_h(r.gyro_rest.white)) << "  # per axis "
-      << vec(r.gyro_rest.white_axes / kDeg * 60.0) << "\n";
+      << vec(r.gyro_rest.white_axes / kDeg * 60.0) << " at tau " << num(r.gyro_rest.white_tau, 3) << " s\n";
     o << "      acc_vrw_m_s_sqrt_h: " << num(vrw_h(r.accel_rest.white)) << "  # per axis "
-      << vec(r.accel_rest.white_axes * 60.0) << "\n";
+      << vec(r.accel_rest.white_axes * 60.0) << " at tau " << num(r.accel_rest.white_tau, 3) << " s\n";
     o << "      gyro_bias_instability_deg_h: " << num(deg_h(r.gyro_rest.bias_instability))
       << "  # " << (r.gyro_rest.floor_reached ? "Allan minimum at " : "an upper bound: still falling at ")
       << num(r.gyro_rest.bias_tau, 3) << " s\n";
