@@ -105,6 +105,17 @@ class Subsystem {
   YawScaleFactors yaw_scale_factor_mode() const { return yaw_mode_; }
   const std::array<int, 2>& yaw_scale_factor_states() const { return yaw_states_; }
   int yaw_scale_factor_state_count() const { return yaw_count_; }
+  /// The variance of the yaw-rate scale factor under the covariance P: the mean of its states'
+  /// block where they are estimated; held, the noise model's gyro_sf_std^2 over the number of
+  /// axes (independent); 0 without yaw states.
+  double yaw_scale_factor_variance(const Mat21& P) const {
+    if (yaw_count_ == 0) return 0.0;
+    if (yaw_mode_ == YawScaleFactors::kHeld) return noise_.gyro_sf_std * noise_.gyro_sf_std / yaw_count_;
+    double v = 0.0;
+    for (int a = 0; a < yaw_count_; ++a)
+      for (int b = 0; b < yaw_count_; ++b) v += P(yaw_states_[a], yaw_states_[b]);
+    return v / (yaw_count_ * yaw_count_);
+  }
 
   /// The noise model in use: the module's figures, as the noise identification has set them
   /// since (fusion/noise_adaptation.hpp), and which states are estimated. Restarts keep it.

@@ -151,11 +151,8 @@ void CentralizedFilter::start() {
   std::array<double, kMaxCentralized> var{};
   for (int j = 0; j < subs_.size(); ++j) {
     const Subsystem& s = subs_[j];
-    const int n = s.yaw_scale_factor_state_count();
-    if (s.yaw_scale_factor_mode() != YawScaleFactors::kFromConstraint || n == 0) continue;
-    const Mat21& P0 = s.ekf().covariance();
-    for (int k = 0; k < n; ++k) var[j] += P0(s.yaw_scale_factor_states()[k], s.yaw_scale_factor_states()[k]);
-    var[j] /= static_cast<double>(n) * n;
+    if (s.yaw_scale_factor_mode() == YawScaleFactors::kFromConstraint)
+      var[j] = s.yaw_scale_factor_variance(s.ekf().covariance());
   }
   const std::array<double, kMaxCentralized> w = inverse_variance_weights(var, subs_.size());
   holds_common_yaw_ = false;

@@ -9,22 +9,6 @@ std::vector<double> configured_weights(const Subsystems& subs) {
   for (int i = 0; i < subs.size(); ++i) w[i] = subs.weight(i);
   return w;
 }
-
-// The variance of a subsystem's yaw-rate scale factor (the mean of its yaw states' scale
-// factors): from its covariance where it is estimated, else from its noise model's gyro
-// scale-factor std, the axes independent (a Wheel-IMU's two axes: half the variance).
-double yaw_scale_factor_variance(const Subsystem& s, const Mat21& P) {
-  const int n = s.yaw_scale_factor_state_count();
-  if (n == 0) return 0.0;
-  if (s.yaw_scale_factor_mode() == YawScaleFactors::kHeld) {
-    const double sd = s.process_noise().gyro_sf_std;
-    return sd * sd / n;
-  }
-  double v = 0.0;
-  for (int a = 0; a < n; ++a)
-    for (int b = 0; b < n; ++b) v += P(s.yaw_scale_factor_states()[a], s.yaw_scale_factor_states()[b]);
-  return v / (n * n);
-}
 }  // namespace
 
 PositionConstraintAid::PositionConstraintAid(const AidContext& ctx)
@@ -79,7 +63,7 @@ void PositionConstraintAid::update_weights() {
           const Vec3 u = s.reference_point_input().C_BtoW.row(2).transpose();
           bias_var0 = u.dot(P.block<3, 3>(9, 9) * u);
         }
-        sf_var0 = yaw_scale_factor_variance(s, P);
+        sf_var0 = s.yaw_scale_factor_variance(P);
       }
       weights_.observe_standalone(i, t, s.vehicle_heading(), s.reference_velocity_inW().head<2>().norm(),
                                   s.process_noise(), s.is_wheel(), bias_var0, sf_var0);
