@@ -938,8 +938,10 @@ TEST_F(RealCar, CalibratedVehicleOnTheOtherTrialBeatsTheOdometryBaseline) {
 }
 
 /// The issue "Every IMU counts": the four hubs and the body drift no more than the rear
-/// Triple (measured on trial04: 0.518 against 0.519 %; the front wheels follow, docs/filter.md
-/// section 16), and the steered pair alone stays within 1.5x of the rear pair (0.483 / 0.486).
+/// Triple (measured on trial04: 0.479 against 0.480 %; the front wheels follow, docs/filter.md
+/// section 16), the rear Triple no more than the rear Dual (0.480 against 0.485; 0.519 while
+/// the engine's vibration at rest was read as the body's angle random walk), and the steered
+/// pair alone stays within 1.5x of the rear pair (0.476 / 0.485).
 TEST_F(RealCar, FourHubsAndTheBodyDriftNoMoreThanTheRearTriple) {
   const auto drift = [](const std::string& selection, const std::string& name) {
     const CmdResult r = wheelins_cli("run -q -m " + q(manifest()) + " " + selection + " --formats csv -o " +
@@ -952,7 +954,28 @@ TEST_F(RealCar, FourHubsAndTheBodyDriftNoMoreThanTheRearTriple) {
   const double five = drift("--modules CAR,IMU4,IMU2,IMU3,IMU1", "five");
   ASSERT_TRUE(std::isfinite(triple) && std::isfinite(five));
   EXPECT_LE(five, 1.05 * triple) << "five " << five << " %, rear Triple " << triple << " %";
-  EXPECT_LE(drift("--modules IMU3,IMU1", "front-dual"), 1.5 * drift("-c dual-wheel", "rear-dual"));
+  const double rear_dual = drift("-c dual-wheel", "rear-dual");
+  EXPECT_LE(triple, 1.05 * rear_dual) << "rear Triple " << triple << " %, rear Dual " << rear_dual << " %";
+  EXPECT_LE(drift("--modules IMU3,IMU1", "front-dual"), 1.5 * rear_dual);
+}
+
+/// The car stood with its engine running: a 22.4 Hz line on every DOT. The body's angle random
+/// walk is read where it has averaged out (measured 0.47 deg/sqrt(h) at 0.13 s on trial04;
+/// at the sample interval trial02 read 2.16), docs/filter.md 13.1.
+TEST_F(RealCar, TheEngineAtRestIsNotReadAsTheBodyGyroNoise) {
+  const CmdResult r =
+      wheelins_cli("run -q -m " + q(manifest()) + " --modules CAR,IMU4 --formats csv -o " + q(dir() / "noise-at-rest"), dir());
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const std::string yaml = iotest::read_text_file(dir() / "noise-at-rest" / "noise.yaml");
+  const auto car = yaml.find("name: \"CAR\"");
+  ASSERT_NE(car, std::string::npos) << yaml;
+  const auto rest = yaml.find("at_rest:", car);
+  ASSERT_NE(rest, std::string::npos) << yaml;
+  const double arw = number_after(yaml.substr(rest), "gyro_arw_deg_sqrt_h:");
+  const double tau = number_after(yaml.substr(rest), "at tau");
+  EXPECT_LT(arw, 1.0) << yaml.substr(rest, 400);
+  EXPECT_GT(arw, 0.1) << yaml.substr(rest, 400);
+  EXPECT_GE(tau, 0.1) << yaml.substr(rest, 400);
 }
 
 /// Two minutes with one U-turn do not tell a wheel's yaw scale factor from zero (trial02:
