@@ -43,12 +43,13 @@ SensorNoiseEstimate estimate_sensor_noise(const AllanAccumulator& a) {
   if (a.samples() < 200) return e;
   e.valid = true;
   e.duration = a.mean_dt() * static_cast<double>(a.samples());
-  // The white noise: on its line sigma_A^2 tau is the same at every tau, while a vibration
-  // (the engine's 22 Hz on the real car, standing with it running) falls as tau^-2 and
-  // reads at the sample interval as an angle random walk several times the chip's, which
-  // does not integrate into the heading; a bias instability or random walk rises. So the
-  // shortest cluster time whose sigma_A^2 tau no longer one is below by more than 3 of
-  // their scatters (1 / sqrt(M) relative for M differences).
+  // The white noise: on its line sigma_A^2 tau is the same at every tau. A vibration (the
+  // engine's 22 Hz on the real car, standing with it running) has a sigma_A^2 falling as
+  // tau^-2: at the sample interval it reads as an angle random walk several times the
+  // chip's, although it does not integrate into the heading. A bias instability or a random
+  // walk makes sigma_A^2 tau rise. So N is read at the shortest cluster time whose
+  // sigma_A^2 tau no longer cluster time undercuts by more than 3 of their scatters (a
+  // relative scatter of 1 / sqrt(M) for M differences).
   const auto usable = [&](int l) {
     return l == 0 || (a.differences(l) >= kWhiteMinDifferences && a.tau(l) <= kWhiteTauMax);
   };

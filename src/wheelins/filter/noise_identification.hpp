@@ -4,10 +4,11 @@
 // (IEEE Std 952-1997, annex C; El-Sheimy, Hou, Niu 2008), at octave cluster times
 // tau = 2^L dt, accumulated sample by sample in O(levels) memory. The white-noise density
 // (ARW for a gyro, VRW for an accelerometer) N^2 = sigma_A^2(tau) tau, the same at every
-// tau on the white-noise line, is read at the shortest tau up to 1 s that no longer one
-// undercuts (a vibration averages out); the curve's minimum gives the bias instability
-// B = min sigma_A / 0.664, or only a bound on it when the curve still falls as tau^-1/2 at
-// the longest cluster time the period allows (a 30 s period cannot show a MEMS gyro's floor).
+// tau on the white-noise line, is read at the shortest tau (up to 1 s) that no longer tau
+// undercuts beyond its scatter (where a vibration has averaged out); the curve's minimum
+// gives the bias instability B = min sigma_A / 0.664, or only a bound on it when the curve
+// still falls as tau^-1/2 at the longest cluster time the period allows (a 30 s period
+// cannot show a MEMS gyro's floor).
 //
 // In motion: the innovations of a velocity update, by Mehra's (1970) correlation
 // method (VelocityNoiseMatcher): their variance alone cannot tell measurement noise
@@ -85,8 +86,8 @@ inline constexpr double kWhiteTauMax = 1.0;
 inline constexpr std::uint64_t kWhiteMinDifferences = 20;
 
 /// Reads an AllanAccumulator: the white noise N^2 = sigma_A^2(tau) tau at the shortest
-/// cluster time (up to kWhiteTauMax, kWhiteMinDifferences differences) that no longer one
-/// undercuts by more than 3 of their scatters: the white-noise line where a vibration has
+/// cluster time (up to kWhiteTauMax, kWhiteMinDifferences differences) that no longer
+/// cluster time undercuts by more than 3 of their scatters: the white-noise line where a vibration has
 /// averaged out and before a bias instability rises; the bias instability from the minimum
 /// of sigma_A over the levels with at least 8 differences.
 SensorNoiseEstimate estimate_sensor_noise(const AllanAccumulator& a);
