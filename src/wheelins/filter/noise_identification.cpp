@@ -47,14 +47,16 @@ SensorNoiseEstimate estimate_sensor_noise(const AllanAccumulator& a) {
   // engine's 22 Hz on the real car, standing with it running) has a sigma_A^2 falling as
   // tau^-2: at the sample interval it reads as an angle random walk several times the
   // chip's, although it does not integrate into the heading. A bias instability or a random
-  // walk makes sigma_A^2 tau rise. So N is read at the shortest cluster time whose
-  // sigma_A^2 tau no longer cluster time undercuts by more than 3 of their scatters (a
+  // walk makes sigma_A^2 tau rise. So N is read at the shortest cluster time l such that no
+  // longer cluster time's sigma_A^2 tau is below l's by more than 3 of their scatters (a
   // relative scatter of 1 / sqrt(M) for M differences).
   const auto usable = [&](int l) {
     return l == 0 || (a.differences(l) >= kWhiteMinDifferences && a.tau(l) <= kWhiteTauMax);
   };
   const auto density = [&](int l) { return a.variance(l).mean() * a.tau(l); };
-  const auto inv_m = [&](int l) { return 1.0 / static_cast<double>(std::max<std::uint64_t>(a.differences(l), 1)); };
+  const auto inv_m = [&](int l) {
+    return 1.0 / static_cast<double>(std::max<std::uint64_t>(a.differences(l), 1));
+  };
   int wl = 0;
   for (int l = 0; l < AllanAccumulator::kLevels; ++l) {
     if (!usable(l)) continue;

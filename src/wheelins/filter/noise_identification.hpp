@@ -86,10 +86,10 @@ inline constexpr double kWhiteTauMax = 1.0;
 inline constexpr std::uint64_t kWhiteMinDifferences = 20;
 
 /// Reads an AllanAccumulator: the white noise N^2 = sigma_A^2(tau) tau at the shortest
-/// cluster time (up to kWhiteTauMax, kWhiteMinDifferences differences) that no longer
-/// cluster time undercuts by more than 3 of their scatters: the white-noise line where a vibration has
-/// averaged out and before a bias instability rises; the bias instability from the minimum
-/// of sigma_A over the levels with at least 8 differences.
+/// cluster time (up to kWhiteTauMax, kWhiteMinDifferences differences) below which no longer
+/// cluster time's sigma_A^2 tau falls by more than 3 of their scatters: the white-noise line
+/// where a vibration has averaged out and before a bias instability rises; the bias
+/// instability from the minimum of sigma_A over the levels with at least 8 differences.
 SensorNoiseEstimate estimate_sensor_noise(const AllanAccumulator& a);
 
 /// Noise identification from the innovations of one velocity measurement (3 axes: axis 0
